@@ -1,0 +1,173 @@
+//! Data meshes: vertices plus optional explicit segments and triangles (SPEC 1).
+//!
+//! A [`Mesh`] is what a file or a procedural generator yields. It holds positions in
+//! `f32` and the simplices the source stated: OBJ `l` polylines become `segments`,
+//! faces of any size become fan-triangulated `triangles`. Which primitive set is built
+//! from it (points, edges, triangles) is decided later, by [`crate::primitives`]; a
+//! mesh never builds what nobody asked for.
+
+mod error;
+mod obj;
+mod ply;
+mod stl;
+
+pub use error::MeshError;
+
+use glam::Vec3;
+use std::path::Path;
+
+/// Vertices and the simplices a source provides.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub vertices: Vec<Vec3>,
+    /// Explicit line segments (OBJ `l` polylines split into consecutive pairs, PLY `edge`
+    /// elements). Empty when the source has none.
+    pub segments: Vec<[u32; 2]>,
+    /// Triangles (polygons are fan-triangulated on load). Empty when the source has none.
+    pub triangles: Vec<[u32; 3]>,
+    /// A short human-readable name (file name or generator name) for messages.
+    pub name: String,
+}
+
+/// Axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The empty box (min = +inf, max = -inf); growing it by a point gives that point.
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::splat(f32::INFINITY),
+        max: Vec3::splat(f32::NEG_INFINITY),
+    };
+
+    pub fn from_points(points: impl IntoIterator<Item = Vec3>) -> Aabb {
+        points.into_iter().fold(Aabb::EMPTY, |b, p| b.grow(p))
+    }
+
+    pub fn grow(self, p: Vec3) -> Aabb {
+        Aabb {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+
+    pub fn union(self, o: Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        !(self.min.x <= self.max.x && self.min.y <= self.max.y && self.min.z <= self.max.z)
+    }
+
+    pub fn center(&self) -> Vec3 {
+        0.5 * (self.min + self.max)
+    }
+
+    pub fn extent(&self) -> Vec3 {
+        self.max - self.min
+    }
+
+    /// Length of the diagonal, in f64 (0 for a single point, 0 for the empty box).
+    pub fn diagonal(&self) -> f64 {
+        if self.is_empty() {
+            return 0.0;
+        }
+        self.extent().as_dvec3().length()
+    }
+}
+
+impl Mesh {
+    /// Reads a mesh, choosing the reader by extension (`.obj`, `.ply`, `.stl`, any case).
+    ///
+    /// Errors name the file and what was wrong; a mesh with no vertices is an error.
+    pub fn load(path: &Path) -> Result<Mesh, MeshError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase())
+            .unwrap_or_default();
+        let mut mesh = match ext.as_str() {
+            "obj" => obj::read_obj(path)?,
+            "ply" => ply::read_ply(path)?,
+            "stl" => stl::read_stl(path)?,
+            _ => {
+                return Err(MeshError::UnknownExtension {
+                    path: path.to_path_buf(),
+                    extension: ext,
+                });
+            }
+        };
+        if mesh.name.is_empty() {
+            mesh.name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+        }
+        mesh.validate(path)?;
+        Ok(mesh)
+    }
+
+    /// Checks the invariants every reader and generator must meet: at least one vertex,
+    /// finite coordinates, indices in range.
+    pub fn validate(&self, path: &Path) -> Result<(), MeshError> {
+        if self.vertices.is_empty() {
+            return Err(MeshError::Empty {
+                path: path.to_path_buf(),
+            });
+        }
+        if let Some(i) = self.vertices.iter().position(|v| !v.is_finite()) {
+            return Err(MeshError::NonFinite {
+                path: path.to_path_buf(),
+                vertex: i,
+            });
+        }
+        let n = self.vertices.len();
+        let bad = self
+            .segments
+            .iter()
+            .flat_map(|s| s.iter())
+            .chain(self.triangles.iter().flat_map(|t| t.iter()))
+            .find(|&&i| i as usize >= n);
+        if let Some(&i) = bad {
+            return Err(MeshError::IndexOutOfRange {
+                path: path.to_path_buf(),
+                line: None,
+                index: i as i64,
+                count: n,
+            });
+        }
+        Ok(())
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points(self.vertices.iter().copied())
+    }
+
+    /// Applies `p -> rotation * (scale * p) + translation` to every vertex.
+    pub fn transform(&mut self, scale: Vec3, rotation: glam::Quat, translation: Vec3) {
+        for v in &mut self.vertices {
+            *v = rotation * (scale * *v) + translation;
+        }
+    }
+
+    /// Unique undirected edges of the triangles, each as `[min, max]`, sorted.
+    pub fn triangle_edges(&self) -> Vec<[u32; 2]> {
+        let mut edges: Vec<[u32; 2]> = self
+            .triangles
+            .iter()
+            .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+            .map(|[a, b]| [a.min(b), a.max(b)])
+            .filter(|[a, b]| a != b)
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        edges
+    }
+}
