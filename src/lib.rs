@@ -3,3 +3,4 @@
 //! `SPEC.md` (shared) for the math.
 
 pub mod mesh;
+pub mod procedural;
