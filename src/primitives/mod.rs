@@ -1,0 +1,29 @@
+//! Primitive sets built from a mesh: points, edges, triangles (SPEC 1).
+
+use serde::Deserialize;
+
+/// Which kind of primitive a set holds. Scene files and the command line name them
+/// `points`, `edges`, `triangles`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum PrimitiveKind {
+    Points,
+    Edges,
+    Triangles,
+}
+
+impl PrimitiveKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            PrimitiveKind::Points => "points",
+            PrimitiveKind::Edges => "edges",
+            PrimitiveKind::Triangles => "triangles",
+        }
+    }
+}
+
+impl std::fmt::Display for PrimitiveKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
