@@ -5,3 +5,6 @@
 pub mod mesh;
 pub mod procedural;
 pub mod primitives;
+pub mod bvh;
+pub mod eval;
+pub mod geometry;

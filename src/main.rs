@@ -1,3 +1,7 @@
-fn main() {
-    println!("smoothtrace");
+//! The `smoothtrace` command line: a thin layer over the library (see `cli/`).
+
+mod cli;
+
+fn main() -> std::process::ExitCode {
+    cli::run()
 }

@@ -1,6 +1,15 @@
-//! Primitive sets built from a mesh: points, edges, triangles (SPEC 1).
+//! Primitive sets built from a mesh: points, edges, triangles (SPEC 1), their weights
+//! (SPEC 4, 5) and their BVHs (SPEC 6).
 
 use serde::Deserialize;
+
+mod kinds;
+mod sets;
+pub mod weights;
+
+pub use kinds::{Edge, Point, Primitive, Term, Triangle};
+pub use sets::{AnySet, BuildTimes, PrimitiveError, PrimitiveSet};
+pub use weights::WeightScale;
 
 /// Which kind of primitive a set holds. Scene files and the command line name them
 /// `points`, `edges`, `triangles`.

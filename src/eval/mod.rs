@@ -1,0 +1,16 @@
+//! Evaluating the smooth distance (SPEC 2) and the exact nearest primitive over one or
+//! more primitive sets.
+//!
+//! - [`smooth`]: the Barnes-Hut traversal (SPEC 6) feeding an accumulator
+//!   ([`accumulate`]) that is either the stable shifted sum or the paper's naive sum.
+//! - [`nearest`]: the exact nearest primitive on the same BVH.
+//! - [`brute`]: f64 brute-force references for tests and reports.
+
+pub mod accumulate;
+pub mod brute;
+pub mod nearest;
+pub mod smooth;
+
+pub use accumulate::Accumulation;
+pub use nearest::{Nearest, nearest};
+pub use smooth::{EvalParams, EvalStats, Sample, evaluate};

@@ -1,0 +1,163 @@
+//! The three primitive types and their terms of the smooth sum (SPEC 2, 3, 4).
+//!
+//! A primitive stores its vertex positions inline (f32) plus the valence data its
+//! weight needs, so the evaluator touches one contiguous array in BVH order. Distances,
+//! closest points and weights are computed in f64.
+
+use super::weights::{self, WeightScale};
+use crate::geometry::closest::{closest_on_segment, closest_on_triangle};
+use crate::mesh::Aabb;
+use glam::{DVec3, Vec3};
+
+/// One term of the smooth sum at a query point `x`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Term {
+    /// Exact distance `d = |x - c|` to the closest point `c`.
+    pub d: f64,
+    /// Unit vector `(x - c) / d`, zero when `x` lies on the primitive.
+    pub dir: DVec3,
+    /// Weight `w >= 1`.
+    pub w: f64,
+    /// Gradient of `w` with respect to `x`.
+    pub grad_w: DVec3,
+}
+
+/// What the BVH and the evaluator need of a primitive.
+pub trait Primitive: Copy + Send + Sync + 'static {
+    fn bounds(&self) -> Aabb;
+    fn centroid(&self) -> Vec3;
+    fn closest_point(&self, x: DVec3) -> DVec3;
+    fn term(&self, x: DVec3, scale: &WeightScale) -> Term;
+}
+
+#[inline]
+fn unit_or_zero(v: DVec3, len: f64) -> DVec3 {
+    if len > 0.0 { v / len } else { DVec3::ZERO }
+}
+
+/// A point primitive (weight 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point {
+    pub p: Vec3,
+}
+
+impl Primitive for Point {
+    fn bounds(&self) -> Aabb {
+        Aabb {
+            min: self.p,
+            max: self.p,
+        }
+    }
+    fn centroid(&self) -> Vec3 {
+        self.p
+    }
+    fn closest_point(&self, _x: DVec3) -> DVec3 {
+        self.p.as_dvec3()
+    }
+    #[inline]
+    fn term(&self, x: DVec3, _scale: &WeightScale) -> Term {
+        let v = x - self.p.as_dvec3();
+        let d = v.length();
+        Term {
+            d,
+            dir: unit_or_zero(v, d),
+            w: 1.0,
+            grad_w: DVec3::ZERO,
+        }
+    }
+}
+
+/// A segment with the valences of its end vertices (edge quartic weight, SPEC 4).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Edge {
+    pub a: Vec3,
+    pub b: Vec3,
+    /// Number of edges incident on `a` and on `b` (>= 1).
+    pub val_a: f32,
+    pub val_b: f32,
+}
+
+impl Primitive for Edge {
+    fn bounds(&self) -> Aabb {
+        Aabb {
+            min: self.a.min(self.b),
+            max: self.a.max(self.b),
+        }
+    }
+    fn centroid(&self) -> Vec3 {
+        0.5 * (self.a + self.b)
+    }
+    fn closest_point(&self, x: DVec3) -> DVec3 {
+        closest_on_segment(x, self.a.as_dvec3(), self.b.as_dvec3()).point
+    }
+    #[inline]
+    fn term(&self, x: DVec3, scale: &WeightScale) -> Term {
+        let (a, b) = (self.a.as_dvec3(), self.b.as_dvec3());
+        let c = closest_on_segment(x, a, b);
+        let v = x - c.point;
+        let d = v.length();
+        let coef = weights::edge_quartic(1.0 / self.val_a as f64, 1.0 / self.val_b as f64);
+        let (raw, draw) = weights::edge_w(c.t, coef);
+        let (w, dw) = scale.apply(raw);
+        let grad_w = if c.interior && dw != 0.0 {
+            let ab = b - a;
+            (dw * draw / ab.length_squared()) * ab
+        } else {
+            DVec3::ZERO
+        };
+        Term {
+            d,
+            dir: unit_or_zero(v, d),
+            w,
+            grad_w,
+        }
+    }
+}
+
+/// A triangle with its largest vertex and edge valences (degree-7 weight, SPEC 4).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    pub a: Vec3,
+    pub b: Vec3,
+    pub c: Vec3,
+    /// Largest number of triangles incident on one of its vertices (>= 1).
+    pub vmax: f32,
+    /// Largest number of triangles incident on one of its edges (>= 1).
+    pub emax: f32,
+}
+
+impl Primitive for Triangle {
+    fn bounds(&self) -> Aabb {
+        Aabb {
+            min: self.a.min(self.b).min(self.c),
+            max: self.a.max(self.b).max(self.c),
+        }
+    }
+    fn centroid(&self) -> Vec3 {
+        (self.a + self.b + self.c) / 3.0
+    }
+    fn closest_point(&self, x: DVec3) -> DVec3 {
+        closest_on_triangle(x, self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3()).point
+    }
+    #[inline]
+    fn term(&self, x: DVec3, scale: &WeightScale) -> Term {
+        let (a, b, c) = (self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3());
+        let cl = closest_on_triangle(x, a, b, c);
+        let v = x - cl.point;
+        let d = v.length();
+        let (raw, ws, wt) = weights::triangle_w(cl.s, cl.t, self.vmax as f64, self.emax as f64);
+        let (w, dw) = scale.apply(raw);
+        let grad_w = if dw != 0.0 {
+            let (gs, gt) = weights::triangle_bary_gradients(cl.feature, b - a, c - a);
+            dw * (ws * gs + wt * gt)
+        } else {
+            DVec3::ZERO
+        };
+        Term {
+            d,
+            dir: unit_or_zero(v, d),
+            w,
+            grad_w,
+        }
+    }
+}

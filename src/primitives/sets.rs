@@ -1,0 +1,264 @@
+//! Building a primitive set from a mesh: valences (SPEC 1), the primitives with their
+//! weight data, and the BVH over them (SPEC 6). Building one set never builds another.
+
+use super::PrimitiveKind;
+use super::kinds::{Edge, Point, Primitive, Triangle};
+use crate::bvh::{self, BuildOptions, Bvh};
+use crate::mesh::{Aabb, Mesh};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// A mesh cannot provide the requested primitive set.
+#[derive(Debug, thiserror::Error)]
+#[error("{mesh}: cannot build {kind}: {reason}")]
+pub struct PrimitiveError {
+    pub mesh: String,
+    pub kind: PrimitiveKind,
+    pub reason: String,
+}
+
+/// Timings of a set's construction, for `--verbose` and the reports.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BuildTimes {
+    /// Extracting primitives and valences, seconds.
+    pub primitives: f64,
+    /// Building the BVH and reordering, seconds.
+    pub bvh: f64,
+}
+
+/// Primitives of one kind in BVH leaf order, with their hierarchy.
+#[derive(Clone, Debug)]
+pub struct PrimitiveSet<P> {
+    /// Primitives in leaf order; `bvh.order[i]` is the source index of `prims[i]`.
+    pub prims: Vec<P>,
+    pub bvh: Bvh,
+    /// Largest valence (SPEC 1); 1 for points.
+    pub max_adj: f64,
+    pub bounds: Aabb,
+    pub times: BuildTimes,
+}
+
+impl<P: Primitive> PrimitiveSet<P> {
+    /// Builds the BVH over `prims` and reorders them into leaf order.
+    pub fn new(prims: Vec<P>, max_adj: f64, options: BuildOptions, prim_seconds: f64) -> Self {
+        let t = Instant::now();
+        let bounds: Vec<Aabb> = prims.par_iter().map(|p| p.bounds()).collect();
+        let centroids: Vec<_> = prims.par_iter().map(|p| p.centroid()).collect();
+        let bvh = bvh::build(&bounds, &centroids, options);
+        drop((bounds, centroids));
+        let sorted: Vec<P> = bvh.order.par_iter().map(|&i| prims[i as usize]).collect();
+        let bounds = bvh
+            .nodes
+            .first()
+            .map(|n| Aabb {
+                min: n.min,
+                max: n.max,
+            })
+            .unwrap_or(Aabb::EMPTY);
+        PrimitiveSet {
+            prims: sorted,
+            bvh,
+            max_adj,
+            bounds,
+            times: BuildTimes {
+                primitives: prim_seconds,
+                bvh: t.elapsed().as_secs_f64(),
+            },
+        }
+    }
+
+    /// Source index (vertex, edge or triangle index) of the primitive at leaf position `i`.
+    pub fn source_index(&self, i: usize) -> u32 {
+        self.bvh.order[i]
+    }
+}
+
+/// A primitive set of any kind.
+#[derive(Clone, Debug)]
+pub enum AnySet {
+    Points(PrimitiveSet<Point>),
+    Edges(PrimitiveSet<Edge>),
+    Triangles(PrimitiveSet<Triangle>),
+}
+
+/// Calls `$body` with `$s` bound to the inner `PrimitiveSet<P>` of an [`AnySet`].
+#[macro_export]
+macro_rules! with_set {
+    ($set:expr, $s:ident => $body:expr) => {
+        match $set {
+            $crate::primitives::AnySet::Points($s) => $body,
+            $crate::primitives::AnySet::Edges($s) => $body,
+            $crate::primitives::AnySet::Triangles($s) => $body,
+        }
+    };
+}
+
+impl AnySet {
+    /// Builds the `kind` set of `mesh` with the default leaf size.
+    pub fn build(mesh: &Mesh, kind: PrimitiveKind) -> Result<AnySet, PrimitiveError> {
+        Self::build_with(mesh, kind, BuildOptions::default())
+    }
+
+    pub fn build_with(
+        mesh: &Mesh,
+        kind: PrimitiveKind,
+        options: BuildOptions,
+    ) -> Result<AnySet, PrimitiveError> {
+        let t = Instant::now();
+        let err = |reason: &str| PrimitiveError {
+            mesh: mesh.name.clone(),
+            kind,
+            reason: reason.to_string(),
+        };
+        if mesh.vertices.is_empty() {
+            return Err(err("the mesh has no vertices"));
+        }
+        Ok(match kind {
+            PrimitiveKind::Points => {
+                let prims = points(mesh);
+                AnySet::Points(PrimitiveSet::new(prims, 1.0, options, secs(t)))
+            }
+            PrimitiveKind::Edges => {
+                let (prims, max_adj) = edges(mesh).ok_or_else(|| {
+                    err("it has no edges (no `l` segments and no faces); use points")
+                })?;
+                AnySet::Edges(PrimitiveSet::new(prims, max_adj, options, secs(t)))
+            }
+            PrimitiveKind::Triangles => {
+                let (prims, max_adj) = triangles(mesh)
+                    .ok_or_else(|| err("it has no faces; use points or edges"))?;
+                AnySet::Triangles(PrimitiveSet::new(prims, max_adj, options, secs(t)))
+            }
+        })
+    }
+
+    pub fn kind(&self) -> PrimitiveKind {
+        match self {
+            AnySet::Points(_) => PrimitiveKind::Points,
+            AnySet::Edges(_) => PrimitiveKind::Edges,
+            AnySet::Triangles(_) => PrimitiveKind::Triangles,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        with_set!(self, s => s.prims.len())
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    pub fn max_adj(&self) -> f64 {
+        with_set!(self, s => s.max_adj)
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        with_set!(self, s => s.bounds)
+    }
+
+    pub fn bvh(&self) -> &Bvh {
+        with_set!(self, s => &s.bvh)
+    }
+
+    pub fn times(&self) -> BuildTimes {
+        with_set!(self, s => s.times)
+    }
+
+    /// Approximate heap memory of the set (primitives and BVH), bytes.
+    pub fn memory_bytes(&self) -> usize {
+        with_set!(self, s => s.prims.len() * std::mem::size_of_val(&s.prims[0]) + s.bvh.memory_bytes())
+    }
+}
+
+fn secs(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64()
+}
+
+fn points(mesh: &Mesh) -> Vec<Point> {
+    mesh.vertices.par_iter().map(|&p| Point { p }).collect()
+}
+
+/// Edges: the mesh's explicit segments, or else the unique edges of its triangles.
+/// `val(v)` counts the edges incident on `v`; `max_adj` is its maximum (SPEC 1).
+fn edges(mesh: &Mesh) -> Option<(Vec<Edge>, f64)> {
+    let list = if mesh.segments.is_empty() {
+        mesh.triangle_edges()
+    } else {
+        mesh.segments.clone()
+    };
+    if list.is_empty() {
+        return None;
+    }
+    let mut val = vec![0u32; mesh.vertices.len()];
+    for &[a, b] in &list {
+        val[a as usize] += 1;
+        if a != b {
+            val[b as usize] += 1;
+        }
+    }
+    let max_adj = val.iter().copied().max().unwrap_or(1).max(1) as f64;
+    let prims = list
+        .iter()
+        .map(|&[a, b]| Edge {
+            a: mesh.vertices[a as usize],
+            b: mesh.vertices[b as usize],
+            val_a: val[a as usize].max(1) as f32,
+            val_b: val[b as usize].max(1) as f32,
+        })
+        .collect();
+    Some((prims, max_adj))
+}
+
+/// Triangles with `vmax` (largest incident-triangle count of their vertices) and `emax`
+/// (largest incident-triangle count of their edges); `max_adj` is the largest vertex or
+/// edge valence (SPEC 1).
+fn triangles(mesh: &Mesh) -> Option<(Vec<Triangle>, f64)> {
+    if mesh.triangles.is_empty() {
+        return None;
+    }
+    let mut vval = vec![0u32; mesh.vertices.len()];
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            // A vertex repeated in a degenerate triangle counts once.
+            if !t[..k].contains(&t[k]) {
+                vval[t[k] as usize] += 1;
+            }
+        }
+    }
+    let key = |a: u32, b: u32| ((a.min(b) as u64) << 32) | a.max(b) as u64;
+    let mut keys: Vec<u64> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| [key(t[0], t[1]), key(t[1], t[2]), key(t[2], t[0])])
+        .collect();
+    keys.par_sort_unstable();
+    let count_of = |k: u64| -> u32 {
+        let lo = keys.partition_point(|&x| x < k);
+        let hi = keys.partition_point(|&x| x <= k);
+        (hi - lo) as u32
+    };
+    let mut max_e = 1u32;
+    let prims: Vec<Triangle> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let vmax = t.iter().map(|&i| vval[i as usize]).max().unwrap_or(1).max(1);
+            let emax = [key(t[0], t[1]), key(t[1], t[2]), key(t[2], t[0])]
+                .into_iter()
+                .map(count_of)
+                .max()
+                .unwrap_or(1)
+                .max(1);
+            max_e = max_e.max(emax);
+            Triangle {
+                a: mesh.vertices[t[0] as usize],
+                b: mesh.vertices[t[1] as usize],
+                c: mesh.vertices[t[2] as usize],
+                vmax: vmax as f32,
+                emax: emax as f32,
+            }
+        })
+        .collect();
+    let max_v = vval.iter().copied().max().unwrap_or(1);
+    Some((prims, max_v.max(max_e).max(1) as f64))
+}

@@ -1,0 +1,335 @@
+//! Weight functions of edges and triangles (SPEC 4) and attenuation (SPEC 5).
+//!
+//! The unscaled weight `W` is a polynomial in the closest point's barycentric
+//! coordinates; the used weight is `w = (max_adj * W)^q` with `q = min(alpha /
+//! max_alpha, 1)`. `W` is clamped to `[1 / max_adj, 1]`, so that every weight lies in
+//! `[1, max_adj^q]`: `w >= 1` keeps the smooth distance below the exact distance
+//! (SPEC 2), and `w <= max_adj^q` keeps the Barnes-Hut far field above every term it
+//! replaces (SPEC 6). The clamp never touches the polynomials' interpolation values; it
+//! catches overshoot (the edge quartic with end valences 1 and 3 peaks at 1.09) and
+//! undershoot, and it keeps weights finite and positive for degenerate input.
+//!
+//! Gradients are exact gradients of `w` with respect to the query point (the closest
+//! point's barycentrics move with the query only on the feature it lies on), so the
+//! gradient of the smooth distance agrees with finite differences.
+
+use glam::DVec3;
+
+/// Coefficients of the degree-7 triangle weight (SPEC 4), `k = A/vmax + B/emax +
+/// C (vmax-1)/vmax`, in the basis listed in [`tri_basis`].
+pub const TRI_A: [f64; 13] = [
+    1.0,
+    -23.283836892152,
+    54.732033227077,
+    -28.569242218786,
+    287.601694832154,
+    -38.617847248620,
+    -336.888198341906,
+    60.434472706056,
+    -96.244440388016,
+    96.200755813732,
+    -24.695579573574,
+    140.043037325921,
+    247.260054961339,
+];
+pub const TRI_B: [f64; 13] = [
+    0.0,
+    36.574687148269,
+    -124.157891685314,
+    111.016227590180,
+    -806.922996604926,
+    105.179057785262,
+    1103.424425061952,
+    -229.648667341166,
+    256.853237918432,
+    -385.711216189244,
+    101.036586502767,
+    -530.902091597253,
+    -885.450169267657,
+];
+pub const TRI_C: [f64; 13] = [
+    0.0,
+    -13.290850256117,
+    69.425858458238,
+    -82.446985371394,
+    519.321301772771,
+    -66.561210536643,
+    -766.536226720045,
+    169.214194635110,
+    -160.608797530416,
+    289.510460375512,
+    -76.341006929192,
+    390.859054271332,
+    638.190114306318,
+];
+
+/// The 13 basis functions of the triangle weight at `(s, t)` and their partial
+/// derivatives with respect to `s` (the `t` partials follow by symmetry, swapping).
+/// Basis: 1, s²+t², s³+t³, s⁴+t⁴, s²t², s⁵+t⁵, s²t³+s³t², s⁶+t⁶, s²t⁴+s⁴t², s³t³,
+/// s⁷+t⁷, s²t⁵+s⁵t², s³t⁴+s⁴t³.
+#[inline]
+pub fn tri_basis(s: f64, t: f64) -> ([f64; 13], [f64; 13]) {
+    let (s2, t2) = (s * s, t * t);
+    let (s3, t3) = (s2 * s, t2 * t);
+    let (s4, t4) = (s3 * s, t3 * t);
+    let (s5, t5) = (s4 * s, t4 * t);
+    let (s6, t6) = (s5 * s, t5 * t);
+    let value = [
+        1.0,
+        s2 + t2,
+        s3 + t3,
+        s4 + t4,
+        s2 * t2,
+        s5 + t5,
+        s2 * t3 + s3 * t2,
+        s6 + t6,
+        s2 * t4 + s4 * t2,
+        s3 * t3,
+        s6 * s + t6 * t,
+        s2 * t5 + s5 * t2,
+        s3 * t4 + s4 * t3,
+    ];
+    let ds = [
+        0.0,
+        2.0 * s,
+        3.0 * s2,
+        4.0 * s3,
+        2.0 * s * t2,
+        5.0 * s4,
+        2.0 * s * t3 + 3.0 * s2 * t2,
+        6.0 * s5,
+        2.0 * s * t4 + 4.0 * s3 * t2,
+        3.0 * s2 * t3,
+        7.0 * s6,
+        2.0 * s * t5 + 5.0 * s4 * t2,
+        3.0 * s2 * t4 + 4.0 * s3 * t3,
+    ];
+    (value, ds)
+}
+
+/// Unclamped triangle weight polynomial `W(s, t)` and its partials `(dW/ds, dW/dt)` for
+/// a triangle whose largest vertex valence is `vmax` and largest edge valence `emax`.
+/// An isolated triangle (`vmax = 1`) has `W = 1` (SPEC 4's trap: the centroid value
+/// `(vmax-1)/vmax` would be 0).
+#[inline]
+pub fn triangle_w(s: f64, t: f64, vmax: f64, emax: f64) -> (f64, f64, f64) {
+    if vmax <= 1.0 {
+        return (1.0, 0.0, 0.0);
+    }
+    let (fa, fb, fc) = (1.0 / vmax, 1.0 / emax, (vmax - 1.0) / vmax);
+    let (bs, dbs) = tri_basis(s, t);
+    let (_, dbt) = tri_basis(t, s);
+    let mut w = 0.0;
+    let mut ws = 0.0;
+    let mut wt = 0.0;
+    for i in 0..13 {
+        let k = fa * TRI_A[i] + fb * TRI_B[i] + fc * TRI_C[i];
+        w += k * bs[i];
+        ws += k * dbs[i];
+        wt += k * dbt[i];
+    }
+    (w, ws, wt)
+}
+
+/// Coefficients `(c0, c2, c3, c4)` of the edge quartic `W(t) = c0 + c2 t² + c3 t³ + c4 t⁴`
+/// with `W(0) = a`, `W(1) = b`, `W(1/2) = 1`, `W'(0) = W'(1) = 0` (SPEC 4), where
+/// `a = 1/val(v0)`, `b = 1/val(v1)`. Solved in closed form: with `D = b - a` and
+/// `E = 16 (1 - a)`: `c2 = E - 5D`, `c3 = 14D - 2E`, `c4 = E - 8D`. An isolated edge
+/// (`a = b = 1`) gets `W = 1`.
+#[inline]
+pub fn edge_quartic(a: f64, b: f64) -> [f64; 4] {
+    let d = b - a;
+    let e = 16.0 * (1.0 - a);
+    [a, e - 5.0 * d, 14.0 * d - 2.0 * e, e - 8.0 * d]
+}
+
+/// Edge weight polynomial value and derivative at `t`.
+#[inline]
+pub fn edge_w(t: f64, c: [f64; 4]) -> (f64, f64) {
+    let t2 = t * t;
+    let w = c[0] + t2 * (c[1] + t * (c[2] + t * c[3]));
+    let dw = t * (2.0 * c[1] + t * (3.0 * c[2] + t * 4.0 * c[3]));
+    (w, dw)
+}
+
+/// Attenuated, clamped weight of one primitive: `w = (max_adj * clamp(W))^q` and the
+/// factor `dw/dW` (zero where the clamp is active), from the raw polynomial value.
+#[derive(Clone, Copy, Debug)]
+pub struct WeightScale {
+    /// Largest valence of the primitive set (SPEC 1).
+    pub max_adj: f64,
+    /// Attenuation exponent `q = min(alpha / max_alpha, 1)` (SPEC 5).
+    pub q: f64,
+}
+
+impl WeightScale {
+    pub fn new(max_adj: f64, alpha: f64, max_alpha: f64) -> WeightScale {
+        WeightScale {
+            max_adj: max_adj.max(1.0),
+            q: (alpha / max_alpha).min(1.0),
+        }
+    }
+
+    /// The largest weight any primitive of the set can have, `max_adj^q`: the weight of
+    /// a Barnes-Hut far-field term (SPEC 6).
+    #[inline]
+    pub fn max_weight(&self) -> f64 {
+        self.pow(self.max_adj)
+    }
+
+    #[inline]
+    fn pow(&self, v: f64) -> f64 {
+        if self.q == 1.0 { v } else { v.powf(self.q) }
+    }
+
+    /// `(w, dw/dW)` for the raw polynomial value `raw`.
+    #[inline]
+    pub fn apply(&self, raw: f64) -> (f64, f64) {
+        let lo = 1.0 / self.max_adj;
+        if raw <= lo {
+            (1.0, 0.0)
+        } else if raw >= 1.0 || raw.is_nan() {
+            (self.max_weight(), 0.0)
+        } else {
+            let w = self.pow(self.max_adj * raw);
+            (w, self.q * w / raw)
+        }
+    }
+}
+
+/// Gradient with respect to the query of the triangle barycentrics `(s, t)` of the
+/// closest point, on the feature where it lies (zero on vertices and for degenerate
+/// triangles). `e1 = b - a`, `e2 = c - a`.
+#[inline]
+pub fn triangle_bary_gradients(
+    feature: crate::geometry::closest::TriFeature,
+    e1: DVec3,
+    e2: DVec3,
+) -> (DVec3, DVec3) {
+    use crate::geometry::closest::TriFeature as F;
+    match feature {
+        F::Face => {
+            // Dual basis in the plane: grad s . e1 = 1, grad s . e2 = 0.
+            let p1 = e1 - e2 * (e1.dot(e2) / e2.length_squared());
+            let p2 = e2 - e1 * (e2.dot(e1) / e1.length_squared());
+            (p1 / p1.length_squared(), p2 / p2.length_squared())
+        }
+        F::EdgeAB => (e1 / e1.length_squared(), DVec3::ZERO),
+        F::EdgeAC => (DVec3::ZERO, e2 / e2.length_squared()),
+        F::EdgeBC => {
+            let bc = e2 - e1;
+            let gu = bc / bc.length_squared();
+            (-gu, gu)
+        }
+        _ => (DVec3::ZERO, DVec3::ZERO),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triangle_value_conditions() {
+        for (vmax, emax) in [(6.0, 2.0), (3.0, 1.0), (12.0, 3.0), (2.0, 2.0)] {
+            let corner = 1.0 / vmax;
+            let third = 1.0 / emax;
+            let centre = (vmax - 1.0) / vmax;
+            let check = |s: f64, t: f64, want: f64| {
+                let (w, _, _) = triangle_w(s, t, vmax, emax);
+                assert!(
+                    (w - want).abs() < 1e-6,
+                    "vmax {vmax} emax {emax} W({s},{t}) = {w}, want {want}"
+                );
+            };
+            check(0.0, 0.0, corner);
+            check(1.0, 0.0, corner);
+            check(0.0, 1.0, corner);
+            for (s, t) in [
+                (1.0 / 3.0, 0.0),
+                (2.0 / 3.0, 0.0),
+                (0.0, 1.0 / 3.0),
+                (0.0, 2.0 / 3.0),
+                (1.0 / 3.0, 2.0 / 3.0),
+                (2.0 / 3.0, 1.0 / 3.0),
+            ] {
+                check(s, t, third);
+            }
+            check(1.0 / 3.0, 1.0 / 3.0, centre);
+        }
+    }
+
+    #[test]
+    fn triangle_normal_derivatives_vanish_on_edges() {
+        let (vmax, emax) = (6.0, 2.0);
+        for i in 0..=20 {
+            let u = i as f64 / 20.0;
+            // Across s = 0 the normal derivative is dW/ds; across t = 0 it is dW/dt.
+            let (_, ws, _) = triangle_w(0.0, u, vmax, emax);
+            let (_, _, wt) = triangle_w(u, 0.0, vmax, emax);
+            assert!(ws.abs() < 1e-9, "dW/ds at (0,{u}) = {ws}");
+            assert!(wt.abs() < 1e-9, "dW/dt at ({u},0) = {wt}");
+            // Across s + t = 1 the normal direction is (1, 1).
+            let (_, ws, wt) = triangle_w(u, 1.0 - u, vmax, emax);
+            assert!((ws + wt).abs() < 1e-6, "dW/dn at ({u},{}) = {}", 1.0 - u, ws + wt);
+            // Numerically too, with a one-sided difference into the triangle.
+            let h = 1e-6;
+            let (w0, _, _) = triangle_w(0.0, u * 0.999, vmax, emax);
+            let (w1, _, _) = triangle_w(h, u * 0.999, vmax, emax);
+            assert!(((w1 - w0) / h).abs() < 1e-4);
+        }
+    }
+
+    #[test]
+    fn triangle_range_matches_spec() {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        let n = 300;
+        for i in 0..=n {
+            for j in 0..=(n - i) {
+                let (w, _, _) = triangle_w(i as f64 / n as f64, j as f64 / n as f64, 6.0, 2.0);
+                lo = lo.min(w);
+                hi = hi.max(w);
+            }
+        }
+        assert!((lo - 0.1665).abs() < 2e-3 && (hi - 0.850).abs() < 2e-3, "[{lo}, {hi}]");
+    }
+
+    #[test]
+    fn triangle_partials_match_finite_differences() {
+        let h = 1e-6;
+        for &(s, t) in &[(0.2, 0.3), (0.6, 0.1), (0.1, 0.8)] {
+            let (_, ws, wt) = triangle_w(s, t, 7.0, 2.0);
+            let fs = (triangle_w(s + h, t, 7.0, 2.0).0 - triangle_w(s - h, t, 7.0, 2.0).0) / (2.0 * h);
+            let ft = (triangle_w(s, t + h, 7.0, 2.0).0 - triangle_w(s, t - h, 7.0, 2.0).0) / (2.0 * h);
+            assert!((ws - fs).abs() < 1e-6 && (wt - ft).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn isolated_triangle_has_unit_weight() {
+        assert_eq!(triangle_w(1.0 / 3.0, 1.0 / 3.0, 1.0, 1.0), (1.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn edge_quartic_conditions() {
+        for (va, vb) in [(1.0, 1.0), (2.0, 2.0), (1.0, 3.0), (4.0, 2.0), (6.0, 1.0)] {
+            let (a, b) = (1.0 / va, 1.0 / vb);
+            let c = edge_quartic(a, b);
+            let (w0, d0) = edge_w(0.0, c);
+            let (w1, d1) = edge_w(1.0, c);
+            let (wh, _) = edge_w(0.5, c);
+            assert!((w0 - a).abs() < 1e-12 && (w1 - b).abs() < 1e-12 && (wh - 1.0).abs() < 1e-12);
+            assert!(d0.abs() < 1e-12 && d1.abs() < 1e-12);
+        }
+        assert_eq!(edge_quartic(1.0, 1.0), [1.0, 0.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn weights_stay_in_bounds() {
+        let ws = WeightScale::new(6.0, 50.0, 100.0);
+        for raw in [-1.0, 0.0, 0.1, 0.5, 0.99, 1.0, 1.5, f64::NAN] {
+            let (w, _) = ws.apply(raw);
+            assert!((1.0..=ws.max_weight()).contains(&w), "w({raw}) = {w}");
+        }
+    }
+}

@@ -1,0 +1,278 @@
+//! The smooth-distance engine against f64 brute force and the properties of SPEC 2-6.
+
+mod common;
+
+use common::{Rng, angle, bumpy_sphere, random_wire, s_scale};
+use glam::DVec3;
+use smoothtrace::bvh;
+use smoothtrace::eval::{self, Accumulation, EvalParams, brute};
+use smoothtrace::mesh::Mesh;
+use smoothtrace::primitives::{AnySet, Primitive, PrimitiveKind};
+
+const KINDS: [PrimitiveKind; 3] = [PrimitiveKind::Points, PrimitiveKind::Edges, PrimitiveKind::Triangles];
+
+/// Queries near the surface (on vertices, near faces) and far away.
+fn queries(mesh: &Mesh, rng: &mut Rng, n: usize) -> Vec<DVec3> {
+    let diag = mesh.bounds().diagonal();
+    let c = mesh.bounds().center().as_dvec3();
+    let mut q = Vec::new();
+    for i in 0..n {
+        let v = mesh.vertices[(rng.next_f64() * mesh.vertices.len() as f64) as usize % mesh.vertices.len()].as_dvec3();
+        q.push(match i % 4 {
+            0 => v,
+            1 => v + 0.01 * diag * rng.vec(),
+            2 => v + 0.2 * diag * rng.vec(),
+            _ => c + 3.0 * diag * rng.unit(),
+        });
+    }
+    q
+}
+
+fn check_against_brute(mesh: &Mesh, kinds: &[PrimitiveKind], alpha_diag: &[f64], seed: u64) {
+    let sets: Vec<AnySet> = kinds.iter().map(|&k| AnySet::build(mesh, k).unwrap()).collect();
+    let refs: Vec<&AnySet> = sets.iter().collect();
+    let diag = mesh.bounds().diagonal();
+    let mut rng = Rng::new(seed);
+    let qs = queries(mesh, &mut rng, 200);
+    for &ad in alpha_diag {
+        let alpha = ad / diag;
+        for max_alpha in [alpha, 2.0 * alpha] {
+            let p = EvalParams::new(alpha, max_alpha, 0.0);
+            for &x in &qs {
+                let got = eval::evaluate(&refs, x, &p);
+                let (s, g, dmin) = brute::smooth_distance(&refs, x, alpha, max_alpha);
+                let tol = 1e-6 * s_scale(s, alpha);
+                assert!(
+                    (got.s - s).abs() <= tol,
+                    "{} {kinds:?} alpha*diag {ad}: s = {} brute {} (diff {}, tol {tol}) at {x}",
+                    mesh.name,
+                    got.s,
+                    s,
+                    (got.s - s).abs()
+                );
+                if g.length() > 1e-6 {
+                    let a = angle(got.grad, g);
+                    assert!(a <= 1e-4, "gradient off by {a} rad at {x}: {} vs {g}", got.grad);
+                }
+                assert!(got.s <= dmin * (1.0 + 1e-12) + 1e-300, "s {} > dmin {dmin}", got.s);
+                let near = eval::nearest(&refs, x);
+                assert!((near.d - dmin).abs() <= 1e-12 * dmin.max(diag * 1e-9), "nearest {} vs {dmin}", near.d);
+            }
+        }
+    }
+}
+
+#[test]
+fn beta0_matches_brute_force_on_procedural_meshes() {
+    let sphere = bumpy_sphere(12, 20);
+    for k in KINDS {
+        check_against_brute(&sphere, &[k], &[3.0, 30.0, 300.0, 3000.0], 1);
+    }
+    check_against_brute(&sphere, &[PrimitiveKind::Triangles, PrimitiveKind::Points], &[50.0], 2);
+    let wire = random_wire(&mut Rng::new(3), 8, 20);
+    check_against_brute(&wire, &[PrimitiveKind::Edges], &[5.0, 100.0, 1000.0], 4);
+    check_against_brute(&wire, &[PrimitiveKind::Points], &[5.0, 100.0], 5);
+}
+
+#[test]
+fn beta0_matches_brute_force_on_data_meshes() {
+    for name in ["bunny-7k.obj", "teapot.obj", "cow.obj", "suzanne.obj"] {
+        let Some(path) = common::data_file(name) else { return };
+        let mesh = Mesh::load(&path).unwrap();
+        for k in KINDS {
+            check_against_brute(&mesh, &[k], &[100.0, 1000.0], 7);
+        }
+    }
+}
+
+#[test]
+fn barnes_hut_never_exceeds_exact_and_is_conservative() {
+    let sphere = bumpy_sphere(16, 24);
+    let mut rng = Rng::new(9);
+    let qs = queries(&sphere, &mut rng, 300);
+    let diag = sphere.bounds().diagonal();
+    for k in KINDS {
+        let set = AnySet::build(&sphere, k).unwrap();
+        for ad in [5.0, 100.0, 2000.0] {
+            let alpha = ad / diag;
+            let exact = EvalParams::new(alpha, alpha, 0.0);
+            for &x in &qs {
+                let s0 = eval::evaluate(&[&set], x, &exact).s;
+                let dmin = eval::nearest(&[&set], x).d;
+                assert!(s0 <= dmin * (1.0 + 1e-12), "s {s0} > dmin {dmin}");
+                for beta in [0.1, 0.5, 1.0] {
+                    let p = EvalParams::new(alpha, alpha, beta);
+                    let sb = eval::evaluate(&[&set], x, &p).s;
+                    // Pruning may raise either value by at most 1e-14 / alpha.
+                    assert!(sb <= s0 + 1e-12 / alpha, "{k} beta {beta}: {sb} > exact {s0} at {x}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn pruning_off_gives_the_same_values() {
+    let sphere = bumpy_sphere(10, 16);
+    let set = AnySet::build(&sphere, PrimitiveKind::Triangles).unwrap();
+    let mut rng = Rng::new(11);
+    for x in queries(&sphere, &mut rng, 100) {
+        let mut p = EvalParams::new(80.0, 80.0, 0.0);
+        let a = eval::evaluate(&[&set], x, &p);
+        p.prune = false;
+        let b = eval::evaluate(&[&set], x, &p);
+        assert!((a.s - b.s).abs() <= 1e-12 * s_scale(b.s, 80.0), "{} vs {}", a.s, b.s);
+        assert!(a.stats.leaves() <= b.stats.leaves());
+        assert_eq!(b.stats.exact as usize, set.len());
+    }
+}
+
+#[test]
+fn nesting_in_alpha_with_unit_weights() {
+    let sphere = bumpy_sphere(10, 16);
+    let set = AnySet::build(&sphere, PrimitiveKind::Points).unwrap();
+    let mut rng = Rng::new(13);
+    for x in queries(&sphere, &mut rng, 100) {
+        let mut last = f64::NEG_INFINITY;
+        for alpha in [0.5, 1.0, 4.0, 16.0, 64.0, 256.0] {
+            let s = eval::evaluate(&[&set], x, &EvalParams::new(alpha, alpha, 0.0)).s;
+            assert!(s >= last - 1e-12, "alpha {alpha}: s {s} < {last}");
+            last = s;
+        }
+    }
+}
+
+#[test]
+fn gradients_match_central_differences() {
+    let sphere = bumpy_sphere(10, 16);
+    let diag = sphere.bounds().diagonal();
+    let mut rng = Rng::new(17);
+    for k in KINDS {
+        let set = AnySet::build(&sphere, k).unwrap();
+        for (alpha, max_alpha) in [(10.0, 10.0), (40.0, 80.0), (5.0, 50.0)] {
+            let p = EvalParams::new(alpha, max_alpha, 0.0);
+            for _ in 0..60 {
+                let x = rng.vec() * 1.6;
+                let h = 1e-6 * diag;
+                let f = |d: DVec3| eval::evaluate(&[&set], x + d, &p).s;
+                let fd = DVec3::new(
+                    f(DVec3::X * h) - f(-DVec3::X * h),
+                    f(DVec3::Y * h) - f(-DVec3::Y * h),
+                    f(DVec3::Z * h) - f(-DVec3::Z * h),
+                ) / (2.0 * h);
+                let g = eval::evaluate(&[&set], x, &p).grad;
+                assert!(
+                    (g - fd).length() <= 1e-4 * g.length().max(1e-3),
+                    "{k} alpha {alpha}/{max_alpha}: grad {g} vs fd {fd} at {x}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn scale_invariance() {
+    let base = bumpy_sphere(10, 16);
+    let mut rng = Rng::new(19);
+    let qs = queries(&base, &mut rng, 80);
+    for kind in KINDS {
+        let set1 = AnySet::build(&base, kind).unwrap();
+        let alpha = 60.0;
+        let p1 = EvalParams::new(alpha, 2.0 * alpha, 0.0);
+        for k in [1e-4f64, 1e-2, 1e2, 1e4] {
+            let mut m = base.clone();
+            for v in &mut m.vertices {
+                *v *= k as f32;
+            }
+            let setk = AnySet::build(&m, kind).unwrap();
+            let pk = EvalParams::new(alpha / k, 2.0 * alpha / k, 0.0);
+            for &x in &qs {
+                // Queries scaled like the mesh: through f32 so both see the same geometry.
+                let x = x.as_vec3().as_dvec3();
+                let s1 = eval::evaluate(&[&set1], x, &p1).s;
+                let sk = eval::evaluate(&[&setk], x * k, &pk).s;
+                assert!(
+                    (sk / k - s1).abs() <= 1e-5 * s_scale(s1, alpha),
+                    "{kind} k {k}: {} vs {s1}",
+                    sk / k
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn stable_evaluator_never_returns_nan_or_inf() {
+    let mut mesh = bumpy_sphere(8, 12);
+    // Degenerate triangles and edges, duplicate and coincident vertices.
+    let n = mesh.vertices.len() as u32;
+    mesh.vertices.push(mesh.vertices[3]);
+    mesh.triangles.push([1, 1, 2]);
+    mesh.triangles.push([3, n, 4]);
+    mesh.triangles.push([5, 5, 5]);
+    let diag = mesh.bounds().diagonal();
+    let wire = Mesh {
+        segments: vec![[0, 0], [1, 2], [2, 1], [3, n]],
+        ..mesh.clone()
+    };
+    let mut rng = Rng::new(23);
+    for (m, kind) in [
+        (&mesh, PrimitiveKind::Triangles),
+        (&wire, PrimitiveKind::Edges),
+        (&mesh, PrimitiveKind::Points),
+    ] {
+        let set = AnySet::build(m, kind).unwrap();
+        for ad in [1.0, 1e2, 1e4, 1e7] {
+            let p = EvalParams::new(ad / diag, ad / diag, 0.5);
+            let mut xs: Vec<DVec3> = m.vertices.iter().map(|v| v.as_dvec3()).collect();
+            for t in &m.triangles {
+                let [a, b, c] = t.map(|i| m.vertices[i as usize].as_dvec3());
+                xs.push((a + b) / 2.0);
+                xs.push((a + b + c) / 3.0);
+            }
+            for _ in 0..20 {
+                xs.push(rng.unit() * 1e6 * diag);
+            }
+            for x in xs {
+                let s = eval::evaluate(&[&set], x, &p);
+                assert!(s.s.is_finite() && s.grad.is_finite(), "{kind} alpha*diag {ad} at {x}: {s:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn naive_mode_underflows_to_infinity_and_says_so() {
+    let mesh = bumpy_sphere(8, 12);
+    let set = AnySet::build(&mesh, PrimitiveKind::Points).unwrap();
+    let mut p = EvalParams::new(1e4, 1e4, 0.0);
+    p.accumulation = Accumulation::Naive;
+    let s = eval::evaluate(&[&set], DVec3::new(0.0, 5.0, 0.0), &p);
+    assert!(s.s == f64::INFINITY && s.underflow);
+    // Where it does not underflow it agrees with the stable sum.
+    p.alpha = 3.0;
+    p.max_alpha = 3.0;
+    let a = eval::evaluate(&[&set], DVec3::new(0.0, 2.0, 0.0), &p);
+    p.accumulation = Accumulation::Stable;
+    let b = eval::evaluate(&[&set], DVec3::new(0.0, 2.0, 0.0), &p);
+    assert!((a.s - b.s).abs() < 1e-12 && !a.underflow);
+}
+
+#[test]
+fn bvh_is_valid_including_duplicate_points() {
+    let mut mesh = bumpy_sphere(20, 30);
+    for _ in 0..1000 {
+        mesh.vertices.push(mesh.vertices[7]);
+    }
+    for k in KINDS {
+        let set = AnySet::build(&mesh, k).unwrap();
+        smoothtrace::with_set!(&set, s => {
+            // Bounds in source order, from the reordered primitives.
+            let mut src = vec![s.prims[0].bounds(); s.prims.len()];
+            for (i, &o) in s.bvh.order.iter().enumerate() {
+                src[o as usize] = s.prims[i].bounds();
+            }
+            bvh::validate(&s.bvh, &src).unwrap();
+        });
+    }
+}
