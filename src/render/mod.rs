@@ -1,0 +1,7 @@
+//! Rendering: objects ready to trace, the sphere tracer (SPEC 7), the image loop.
+
+pub mod object;
+pub mod tracer;
+
+pub use object::TraceObject;
+pub use tracer::{Hit, RayResult, RayStats, Tracer, TracerOptions};

@@ -1,0 +1,65 @@
+//! A traceable object: one or more primitive sets summed into one smooth distance
+//! (SPEC 2), with its evaluation parameters and the bound of where its surface can be.
+
+use crate::eval::{self, EvalParams, Sample};
+use crate::mesh::Aabb;
+use crate::primitives::{AnySet, WeightScale};
+use glam::DVec3;
+
+/// Primitive sets summed into one smooth distance, evaluated with `params`.
+pub struct TraceObject {
+    pub sets: Vec<AnySet>,
+    pub params: EvalParams,
+    /// Union of the sets' bounding boxes.
+    pub bounds: Aabb,
+    /// Index of the object's shader (MatCap) in the scene.
+    pub shader: usize,
+}
+
+impl TraceObject {
+    pub fn new(sets: Vec<AnySet>, params: EvalParams, shader: usize) -> TraceObject {
+        let bounds = sets.iter().fold(Aabb::EMPTY, |b, s| b.union(s.bounds()));
+        TraceObject {
+            sets,
+            params,
+            bounds,
+            shader,
+        }
+    }
+
+    pub fn set_refs(&self) -> Vec<&AnySet> {
+        self.sets.iter().collect()
+    }
+
+    /// How far outside the data's bounding box the zero set can reach at sharpness
+    /// `alpha`: every evaluation (at any beta) satisfies `s(x) >= r(x) - ln(N w_max) /
+    /// alpha` with `r` the distance to the box, because the sum is at most `N w_max
+    /// exp(-alpha r)`.
+    pub fn reach(&self, alpha: f64) -> f64 {
+        let n: usize = self.sets.iter().map(|s| s.len()).sum();
+        let w_max = self
+            .sets
+            .iter()
+            .map(|s| WeightScale::new(s.max_adj(), alpha, self.params.max_alpha).max_weight())
+            .fold(1.0, f64::max);
+        (n.max(1) as f64 * w_max).ln() / alpha
+    }
+
+    /// A lower bound of the smooth distance at `x` that costs no traversal.
+    pub fn lower_bound(&self, x: DVec3, reach: f64) -> f64 {
+        let (r, _) = crate::geometry::closest::closest_on_box(
+            x,
+            self.bounds.min.as_dvec3(),
+            self.bounds.max.as_dvec3(),
+        );
+        r - reach
+    }
+
+    /// Evaluates the smooth distance with the object's parameters (alpha possibly
+    /// replaced, for the naive mode's falloff).
+    pub fn evaluate(&self, sets: &[&AnySet], x: DVec3, alpha: f64) -> Sample {
+        let mut p = self.params;
+        p.alpha = alpha;
+        eval::evaluate(sets, x, &p)
+    }
+}

@@ -1,0 +1,248 @@
+//! Sphere tracing of the zero set of the scene's smooth distance (SPEC 7).
+//!
+//! The scene's field is the minimum over objects of their smooth distances. Along a ray
+//! `x(t) = o + t d` (unit `d`):
+//! 1. Clip the ray to the union of the objects' boxes grown by their reach
+//!    (`ln(N w_max) / alpha`, see [`TraceObject::reach`]): outside it the field is
+//!    positive, so a ray missing it is a miss with no evaluation, and `t_max` is exact.
+//! 2. Step `t += s(x(t))`. An object whose cheap lower bound (box distance minus reach)
+//!    is already above the current minimum is not evaluated.
+//! 3. Naive mode only: when an evaluation is `+inf` (the sum underflowed), retry with
+//!    `alpha / 10` until finite and step by that smaller, safe value (alpha falloff).
+//! 4. Hit when `|s| <= epsilon`. A step that lands below `-epsilon` (the smooth distance
+//!    is not a lower bound of the distance to its own zero set) is backtracked: the
+//!    crossing is bracketed by the last positive `t` and this one and found by the
+//!    Illinois (safeguarded regula falsi) method to within `epsilon`.
+//! 5. The normal is the normalised gradient at the hit.
+
+use super::object::TraceObject;
+use crate::eval::EvalStats;
+use crate::primitives::AnySet;
+use glam::DVec3;
+
+/// Tracer settings.
+#[derive(Clone, Copy, Debug)]
+pub struct TracerOptions {
+    /// Hit threshold in world units.
+    pub epsilon: f64,
+    /// Largest number of field evaluations per ray before giving up (a miss).
+    pub max_steps: u32,
+}
+
+/// A ray's intersection with the zero set.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f64,
+    pub point: DVec3,
+    /// Unit normal in world space (zero if the gradient vanished).
+    pub normal: DVec3,
+    /// Index of the object whose smooth distance is smallest at the hit.
+    pub object: usize,
+}
+
+/// Work done for one ray.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RayStats {
+    /// Field evaluations (one per object evaluated per step).
+    pub evals: u32,
+    /// Sum of the evaluations' statistics (leaves, nodes).
+    pub eval: EvalStats,
+    /// Retries with a smaller alpha after an infinite (underflowed) naive evaluation.
+    pub falloffs: u32,
+    /// Evaluations spent locating a crossing after overshooting into the negative band.
+    pub backtracks: u32,
+    /// The ray ran out of steps (counted as a miss).
+    pub exhausted: bool,
+}
+
+/// The result of tracing one ray.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RayResult {
+    pub hit: Option<Hit>,
+    pub stats: RayStats,
+}
+
+struct FieldSample {
+    s: f64,
+    grad: DVec3,
+    object: usize,
+}
+
+/// Traces rays against a set of objects.
+pub struct Tracer<'a> {
+    objects: &'a [TraceObject],
+    sets: Vec<Vec<&'a AnySet>>,
+    reach: Vec<f64>,
+    /// Union of the grown object boxes.
+    min: DVec3,
+    max: DVec3,
+    options: TracerOptions,
+}
+
+impl<'a> Tracer<'a> {
+    pub fn new(objects: &'a [TraceObject], options: TracerOptions) -> Tracer<'a> {
+        let reach: Vec<f64> = objects.iter().map(|o| o.reach(o.params.alpha)).collect();
+        let mut min = DVec3::splat(f64::INFINITY);
+        let mut max = DVec3::splat(f64::NEG_INFINITY);
+        for (o, &r) in objects.iter().zip(&reach) {
+            min = min.min(o.bounds.min.as_dvec3() - r);
+            max = max.max(o.bounds.max.as_dvec3() + r);
+        }
+        Tracer {
+            objects,
+            sets: objects.iter().map(|o| o.set_refs()).collect(),
+            reach,
+            min,
+            max,
+            options,
+        }
+    }
+
+    pub fn options(&self) -> &TracerOptions {
+        &self.options
+    }
+
+    /// The scene field at `x`: the minimum over objects.
+    pub fn field(&self, x: DVec3, stats: &mut RayStats) -> (f64, DVec3, usize) {
+        let f = self.sample(x, stats);
+        (f.s, f.grad, f.object)
+    }
+
+    fn sample(&self, x: DVec3, stats: &mut RayStats) -> FieldSample {
+        let mut best = FieldSample {
+            s: f64::INFINITY,
+            grad: DVec3::ZERO,
+            object: 0,
+        };
+        for (k, obj) in self.objects.iter().enumerate() {
+            if self.objects.len() > 1 && obj.lower_bound(x, self.reach[k]) >= best.s {
+                continue;
+            }
+            let mut alpha = obj.params.alpha;
+            let mut sample = obj.evaluate(&self.sets[k], x, alpha);
+            stats.evals += 1;
+            stats.eval.add(&sample.stats);
+            // Alpha falloff (naive mode): a smaller alpha gives a smaller, finite s.
+            while sample.s == f64::INFINITY && alpha > 1e-300 {
+                alpha /= 10.0;
+                sample = obj.evaluate(&self.sets[k], x, alpha);
+                stats.falloffs += 1;
+                stats.evals += 1;
+                stats.eval.add(&sample.stats);
+            }
+            if sample.s < best.s {
+                best = FieldSample {
+                    s: sample.s,
+                    grad: sample.grad,
+                    object: k,
+                };
+            }
+        }
+        best
+    }
+
+    /// The parameter interval where the ray is inside the grown scene box, if any.
+    fn clip(&self, o: DVec3, d: DVec3) -> Option<(f64, f64)> {
+        let inv = d.recip();
+        let t1 = (self.min - o) * inv;
+        let t2 = (self.max - o) * inv;
+        // NaN from 0 * inf (ray in a box plane) is dropped by min/max.
+        let tmin = t1.min(t2).max_element().max(0.0);
+        let tmax = t1.max(t2).min_element();
+        (tmin <= tmax).then_some((tmin, tmax))
+    }
+
+    /// Traces the ray from `o` along unit `d`, starting no earlier than `t_start`.
+    pub fn trace(&self, o: DVec3, d: DVec3, t_start: f64) -> RayResult {
+        let mut stats = RayStats::default();
+        let eps = self.options.epsilon;
+        // The zero set at the object's own alpha lies inside the grown box in both
+        // modes (falloff only shortens steps), so the clip holds for the naive sum too.
+        let Some((t_enter, t_max)) = self.clip(o, d) else {
+            return RayResult { hit: None, stats };
+        };
+        let mut t = t_enter.max(t_start);
+        let mut prev: Option<(f64, f64)> = None;
+        while t <= t_max {
+            if stats.evals >= self.options.max_steps {
+                stats.exhausted = true;
+                return RayResult { hit: None, stats };
+            }
+            let f = self.sample(o + t * d, &mut stats);
+            if f.s.abs() <= eps {
+                return RayResult {
+                    hit: Some(self.hit(o, d, t, &f)),
+                    stats,
+                };
+            }
+            if f.s < 0.0 {
+                let hit = match prev {
+                    Some((tp, sp)) => self.backtrack(o, d, (tp, sp), (t, f.s), &mut stats),
+                    // Negative at the first sample: the ray starts inside the band.
+                    None => Some(self.hit(o, d, t, &f)),
+                };
+                return RayResult { hit, stats };
+            }
+            prev = Some((t, f.s));
+            t += f.s;
+        }
+        RayResult { hit: None, stats }
+    }
+
+    fn hit(&self, o: DVec3, d: DVec3, t: f64, f: &FieldSample) -> Hit {
+        Hit {
+            t,
+            point: o + t * d,
+            normal: f.grad.normalize_or_zero(),
+            object: f.object,
+        }
+    }
+
+    /// Finds the crossing in `[lo, hi]` (`s(lo) > 0 > s(hi)`) by the Illinois method.
+    fn backtrack(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        (mut lo, mut s_lo): (f64, f64),
+        (mut hi, mut s_hi): (f64, f64),
+        stats: &mut RayStats,
+    ) -> Option<Hit> {
+        let eps = self.options.epsilon;
+        let mut side = 0i8;
+        let mut last = None;
+        for _ in 0..64 {
+            if stats.evals >= self.options.max_steps {
+                stats.exhausted = true;
+                break;
+            }
+            let mut t = (lo * s_hi - hi * s_lo) / (s_hi - s_lo);
+            if !(t > lo && t < hi) {
+                t = 0.5 * (lo + hi);
+            }
+            let before = stats.evals;
+            let f = self.sample(o + t * d, stats);
+            stats.backtracks += stats.evals - before;
+            let h = self.hit(o, d, t, &f);
+            if f.s.abs() <= eps || hi - lo <= eps {
+                return Some(h);
+            }
+            last = Some(h);
+            if f.s > 0.0 {
+                lo = t;
+                s_lo = f.s;
+                if side == 1 {
+                    s_hi *= 0.5;
+                }
+                side = 1;
+            } else {
+                hi = t;
+                s_hi = f.s;
+                if side == -1 {
+                    s_lo *= 0.5;
+                }
+                side = -1;
+            }
+        }
+        last
+    }
+}
