@@ -5,8 +5,32 @@
 //! [`Generator`] enum is what a scene file names (`generator = { kind = "torus", ... }`);
 //! every parameter has a default that gives the Table 1 size.
 
+mod bowl;
+mod bucky_ball;
+mod hex_torus;
+mod net;
+mod sphere_points;
+mod spiky_sphere;
+mod torus;
+mod validate;
+
+#[cfg(test)]
+mod check;
+#[cfg(test)]
+mod tests;
+
+pub use bowl::bowl;
+pub use bucky_ball::{bucky_ball, truncated_icosahedron};
+pub use hex_torus::hex_torus;
+pub use net::net;
+pub use sphere_points::sphere_points;
+pub use spiky_sphere::spiky_sphere;
+pub use torus::torus;
+pub use validate::MAX_PRIMITIVES;
+
 use crate::mesh::Mesh;
 use serde::Deserialize;
+use validate::Check;
 
 /// A procedural shape and its parameters, as written in a scene file.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -145,8 +169,115 @@ impl Generator {
         }
     }
 
-    /// Builds the mesh, after checking the parameters (positive radii, enough segments).
+    /// Builds the mesh, after checking the parameters (positive finite radii, minor radius
+    /// below the major one, enough segments, at most [`MAX_PRIMITIVES`] primitives).
     pub fn build(&self) -> Result<Mesh, GeneratorError> {
-        unimplemented!("procedural generators are being written")
+        let c = Check::new(self.name());
+        // Products of two counts fit in u128; constant factors saturate.
+        let n = |x: usize| x as u128;
+        let mut mesh = match *self {
+            Generator::Torus {
+                major_radius,
+                minor_radius,
+                major_segments,
+                minor_segments,
+            } => {
+                c.positive("major_radius", major_radius)?;
+                c.positive("minor_radius", minor_radius)?;
+                c.smaller("minor_radius", minor_radius, "major_radius", major_radius)?;
+                c.at_least("major_segments", major_segments, 3)?;
+                c.at_least("minor_segments", minor_segments, 3)?;
+                c.primitives(
+                    (n(major_segments) * n(minor_segments)).saturating_mul(2),
+                    &format!("2 x `major_segments` = {major_segments} x `minor_segments` = {minor_segments} triangles"),
+                )?;
+                torus(major_radius, minor_radius, major_segments, minor_segments)
+            }
+            Generator::HexTorus {
+                major_radius,
+                minor_radius,
+            } => {
+                c.positive("major_radius", major_radius)?;
+                c.positive("minor_radius", minor_radius)?;
+                c.smaller("minor_radius", minor_radius, "major_radius", major_radius)?;
+                hex_torus(major_radius, minor_radius)
+            }
+            Generator::Bowl {
+                radius,
+                rings,
+                segments,
+            } => {
+                c.positive("radius", radius)?;
+                c.at_least("rings", rings, 2)?;
+                c.at_least("segments", segments, 3)?;
+                c.primitives(
+                    (n(rings) * n(segments)).saturating_mul(2) - n(segments),
+                    &format!("(2 x `rings` = {rings} - 1) x `segments` = {segments} edges"),
+                )?;
+                bowl(radius, rings, segments)
+            }
+            Generator::Net {
+                width,
+                depth,
+                nx,
+                nz,
+                sag,
+            } => {
+                c.positive("width", width)?;
+                c.positive("depth", depth)?;
+                c.finite("sag", sag)?;
+                c.at_least("nx", nx, 2)?;
+                c.at_least("nz", nz, 2)?;
+                c.primitives(
+                    (n(nx) * n(nz)).saturating_mul(2) - n(nx) - n(nz),
+                    &format!("2 x `nx` = {nx} x `nz` = {nz} - nx - nz edges"),
+                )?;
+                net(width, depth, nx, nz, sag)
+            }
+            Generator::BuckyBall {
+                radius,
+                tube_radius,
+                sides,
+                segments,
+            } => {
+                c.positive("radius", radius)?;
+                c.positive("tube_radius", tube_radius)?;
+                c.smaller("tube_radius", tube_radius, "radius", radius)?;
+                c.at_least("sides", sides, 3)?;
+                c.at_least("segments", segments, 2)?;
+                c.primitives(
+                    (n(sides) * n(segments)).saturating_mul(180),
+                    &format!("90 x 2 x `sides` = {sides} x `segments` = {segments} triangles"),
+                )?;
+                bucky_ball(radius, tube_radius, sides, segments)
+            }
+            Generator::SpherePoints { radius, count } => {
+                c.positive("radius", radius)?;
+                c.at_least("count", count, 1)?;
+                c.primitives(n(count), &format!("`count` = {count} points"))?;
+                sphere_points(radius, count)
+            }
+            Generator::SpikySphere {
+                radius,
+                subdivisions,
+                spike_length,
+            } => {
+                c.positive("radius", radius)?;
+                c.positive("spike_length", spike_length)?;
+                // 20 * 4^s triangles + 10 * 4^s + 2 spikes; 4^s overflows u128 past s = 63.
+                let faces = 1u128
+                    .checked_shl(2 * subdivisions.min(64) as u32)
+                    .unwrap_or(u128::MAX);
+                c.primitives(
+                    faces.saturating_mul(30).saturating_add(2),
+                    &format!(
+                        "`subdivisions` = {subdivisions}: 20 x 4^s triangles + 10 x 4^s + 2 spikes"
+                    ),
+                )?;
+                spiky_sphere(radius, subdivisions, spike_length)
+            }
+        };
+        mesh.name = self.name().to_string();
+        Ok(mesh)
     }
 }
