@@ -12,18 +12,15 @@ pub struct TraceObject {
     pub params: EvalParams,
     /// Union of the sets' bounding boxes.
     pub bounds: Aabb,
-    /// Index of the object's shader (MatCap) in the scene.
-    pub shader: usize,
 }
 
 impl TraceObject {
-    pub fn new(sets: Vec<AnySet>, params: EvalParams, shader: usize) -> TraceObject {
+    pub fn new(sets: Vec<AnySet>, params: EvalParams) -> TraceObject {
         let bounds = sets.iter().fold(Aabb::EMPTY, |b, s| b.union(s.bounds()));
         TraceObject {
             sets,
             params,
             bounds,
-            shader,
         }
     }
 

@@ -1,0 +1,142 @@
+//! The image loop: one ray per pixel centre, traced in parallel by rows, shaded with the
+//! hit object's MatCap (SPEC 8) using the camera-space normal. Pixels are independent,
+//! so the image does not depend on the thread count.
+
+use super::tracer::{RayResult, Tracer};
+use crate::camera::Camera;
+use crate::matcap::MatCap;
+use image::RgbImage;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Per-image statistics (SPEC 7).
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct ImageStats {
+    pub width: u32,
+    pub height: u32,
+    pub rays: u64,
+    pub hits: u64,
+    pub misses: u64,
+    /// Rays that ran out of steps (counted in `misses`).
+    pub exhausted: u64,
+    /// Field evaluations over all rays.
+    pub evals: u64,
+    /// Field evaluations over the rays that hit.
+    pub hit_evals: u64,
+    pub max_evals_per_ray: u32,
+    /// Exact plus far-field terms over all evaluations.
+    pub leaves: u64,
+    /// BVH nodes visited over all evaluations.
+    pub nodes: u64,
+    pub falloffs: u64,
+    pub backtracks: u64,
+    /// The camera origin is inside the surface (the image is all background).
+    pub camera_inside: bool,
+    /// Wall-clock seconds of the tracing loop.
+    pub seconds: f64,
+    pub threads: usize,
+}
+
+impl ImageStats {
+    pub fn evals_per_ray(&self) -> f64 {
+        self.evals as f64 / self.rays.max(1) as f64
+    }
+    pub fn evals_per_hit(&self) -> f64 {
+        self.hit_evals as f64 / self.hits.max(1) as f64
+    }
+    pub fn leaves_per_eval(&self) -> f64 {
+        self.leaves as f64 / self.evals.max(1) as f64
+    }
+    pub fn rays_per_second(&self) -> f64 {
+        self.rays as f64 / self.seconds.max(1e-12)
+    }
+}
+
+/// A rendered image with its per-pixel hit distances.
+pub struct Rendered {
+    pub image: RgbImage,
+    /// Ray parameter `t` of the hit per pixel (row-major), `+inf` for misses.
+    pub depth: Vec<f32>,
+    pub stats: ImageStats,
+}
+
+/// Renders `camera`'s view. `progress` is called with the number of rows finished so far.
+pub fn render(
+    tracer: &Tracer,
+    camera: &Camera,
+    shaders: &[MatCap],
+    background: [u8; 3],
+    progress: &(dyn Fn(u64) + Sync),
+) -> Rendered {
+    let (w, h) = (camera.width(), camera.height());
+    let start = Instant::now();
+    let mut stats = ImageStats {
+        width: w,
+        height: h,
+        rays: w as u64 * h as u64,
+        threads: rayon::current_num_threads(),
+        ..Default::default()
+    };
+    let origin = camera.origin();
+    let mut probe = Default::default();
+    let (s0, _, _) = tracer.field(origin, &mut probe);
+    let mut image = RgbImage::from_pixel(w, h, image::Rgb(background));
+    let mut depth = vec![f32::INFINITY; (w * h) as usize];
+    if s0 <= 0.0 {
+        stats.camera_inside = true;
+        stats.misses = stats.rays;
+        stats.seconds = start.elapsed().as_secs_f64();
+        return Rendered {
+            image,
+            depth,
+            stats,
+        };
+    }
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let rows: Vec<Vec<RayResult>> = (0..h)
+        .into_par_iter()
+        .map(|py| {
+            let row = (0..w)
+                .map(|px| {
+                    let (o, d) = camera.ray(px, py);
+                    tracer.trace(o, d, s0)
+                })
+                .collect();
+            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(n);
+            row
+        })
+        .collect();
+    for (py, row) in rows.iter().enumerate() {
+        for (px, r) in row.iter().enumerate() {
+            let st = &r.stats;
+            stats.evals += st.evals as u64;
+            stats.max_evals_per_ray = stats.max_evals_per_ray.max(st.evals);
+            stats.leaves += st.eval.leaves() as u64;
+            stats.nodes += st.eval.nodes as u64;
+            stats.falloffs += st.falloffs as u64;
+            stats.backtracks += st.backtracks as u64;
+            stats.exhausted += st.exhausted as u64;
+            match r.hit {
+                Some(hit) => {
+                    stats.hits += 1;
+                    stats.hit_evals += st.evals as u64;
+                    let n = camera.to_camera_space(hit.normal);
+                    let c = shaders
+                        .get(hit.object)
+                        .map(|m| m.shade(n))
+                        .unwrap_or([255, 0, 255]);
+                    image.put_pixel(px as u32, py as u32, image::Rgb(c));
+                    depth[py * w as usize + px] = hit.t as f32;
+                }
+                None => stats.misses += 1,
+            }
+        }
+    }
+    stats.seconds = start.elapsed().as_secs_f64();
+    Rendered {
+        image,
+        depth,
+        stats,
+    }
+}
