@@ -2,10 +2,10 @@
 //! clouds, edge meshes and triangle meshes. See `ARCHITECTURE.md` for the data flow and
 //! `SPEC.md` (shared) for the math.
 
-pub mod mesh;
-pub mod procedural;
-pub mod primitives;
 pub mod bvh;
 pub mod eval;
 pub mod geometry;
+pub mod mesh;
+pub mod primitives;
+pub mod procedural;
 pub mod render;

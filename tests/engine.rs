@@ -9,7 +9,11 @@ use smoothtrace::eval::{self, Accumulation, EvalParams, brute};
 use smoothtrace::mesh::Mesh;
 use smoothtrace::primitives::{AnySet, Primitive, PrimitiveKind};
 
-const KINDS: [PrimitiveKind; 3] = [PrimitiveKind::Points, PrimitiveKind::Edges, PrimitiveKind::Triangles];
+const KINDS: [PrimitiveKind; 3] = [
+    PrimitiveKind::Points,
+    PrimitiveKind::Edges,
+    PrimitiveKind::Triangles,
+];
 
 /// Queries near the surface (on vertices, near faces) and far away.
 fn queries(mesh: &Mesh, rng: &mut Rng, n: usize) -> Vec<DVec3> {
@@ -17,7 +21,9 @@ fn queries(mesh: &Mesh, rng: &mut Rng, n: usize) -> Vec<DVec3> {
     let c = mesh.bounds().center().as_dvec3();
     let mut q = Vec::new();
     for i in 0..n {
-        let v = mesh.vertices[(rng.next_f64() * mesh.vertices.len() as f64) as usize % mesh.vertices.len()].as_dvec3();
+        let v = mesh.vertices
+            [(rng.next_f64() * mesh.vertices.len() as f64) as usize % mesh.vertices.len()]
+        .as_dvec3();
         q.push(match i % 4 {
             0 => v,
             1 => v + 0.01 * diag * rng.vec(),
@@ -29,7 +35,10 @@ fn queries(mesh: &Mesh, rng: &mut Rng, n: usize) -> Vec<DVec3> {
 }
 
 fn check_against_brute(mesh: &Mesh, kinds: &[PrimitiveKind], alpha_diag: &[f64], seed: u64) {
-    let sets: Vec<AnySet> = kinds.iter().map(|&k| AnySet::build(mesh, k).unwrap()).collect();
+    let sets: Vec<AnySet> = kinds
+        .iter()
+        .map(|&k| AnySet::build(mesh, k).unwrap())
+        .collect();
     let refs: Vec<&AnySet> = sets.iter().collect();
     let diag = mesh.bounds().diagonal();
     let mut rng = Rng::new(seed);
@@ -52,11 +61,23 @@ fn check_against_brute(mesh: &Mesh, kinds: &[PrimitiveKind], alpha_diag: &[f64],
                 );
                 if g.length() > 1e-6 {
                     let a = angle(got.grad, g);
-                    assert!(a <= 1e-4, "gradient off by {a} rad at {x}: {} vs {g}", got.grad);
+                    assert!(
+                        a <= 1e-4,
+                        "gradient off by {a} rad at {x}: {} vs {g}",
+                        got.grad
+                    );
                 }
-                assert!(got.s <= dmin * (1.0 + 1e-12) + 1e-300, "s {} > dmin {dmin}", got.s);
+                assert!(
+                    got.s <= dmin * (1.0 + 1e-12) + 1e-300,
+                    "s {} > dmin {dmin}",
+                    got.s
+                );
                 let near = eval::nearest(&refs, x);
-                assert!((near.d - dmin).abs() <= 1e-12 * dmin.max(diag * 1e-9), "nearest {} vs {dmin}", near.d);
+                assert!(
+                    (near.d - dmin).abs() <= 1e-12 * dmin.max(diag * 1e-9),
+                    "nearest {} vs {dmin}",
+                    near.d
+                );
             }
         }
     }
@@ -68,7 +89,12 @@ fn beta0_matches_brute_force_on_procedural_meshes() {
     for k in KINDS {
         check_against_brute(&sphere, &[k], &[3.0, 30.0, 300.0, 3000.0], 1);
     }
-    check_against_brute(&sphere, &[PrimitiveKind::Triangles, PrimitiveKind::Points], &[50.0], 2);
+    check_against_brute(
+        &sphere,
+        &[PrimitiveKind::Triangles, PrimitiveKind::Points],
+        &[50.0],
+        2,
+    );
     let wire = random_wire(&mut Rng::new(3), 8, 20);
     check_against_brute(&wire, &[PrimitiveKind::Edges], &[5.0, 100.0, 1000.0], 4);
     check_against_brute(&wire, &[PrimitiveKind::Points], &[5.0, 100.0], 5);
@@ -77,7 +103,9 @@ fn beta0_matches_brute_force_on_procedural_meshes() {
 #[test]
 fn beta0_matches_brute_force_on_data_meshes() {
     for name in ["bunny-7k.obj", "teapot.obj", "cow.obj", "suzanne.obj"] {
-        let Some(path) = common::data_file(name) else { return };
+        let Some(path) = common::data_file(name) else {
+            return;
+        };
         let mesh = Mesh::load(&path).unwrap();
         for k in KINDS {
             check_against_brute(&mesh, &[k], &[100.0, 1000.0], 7);
@@ -104,7 +132,10 @@ fn barnes_hut_never_exceeds_exact_and_is_conservative() {
                     let p = EvalParams::new(alpha, alpha, beta);
                     let sb = eval::evaluate(&[&set], x, &p).s;
                     // Pruning may raise either value by at most 1e-14 / alpha.
-                    assert!(sb <= s0 + 1e-12 / alpha, "{k} beta {beta}: {sb} > exact {s0} at {x}");
+                    assert!(
+                        sb <= s0 + 1e-12 / alpha,
+                        "{k} beta {beta}: {sb} > exact {s0} at {x}"
+                    );
                 }
             }
         }
@@ -121,7 +152,12 @@ fn pruning_off_gives_the_same_values() {
         let a = eval::evaluate(&[&set], x, &p);
         p.prune = false;
         let b = eval::evaluate(&[&set], x, &p);
-        assert!((a.s - b.s).abs() <= 1e-12 * s_scale(b.s, 80.0), "{} vs {}", a.s, b.s);
+        assert!(
+            (a.s - b.s).abs() <= 1e-12 * s_scale(b.s, 80.0),
+            "{} vs {}",
+            a.s,
+            b.s
+        );
         assert!(a.stats.leaves() <= b.stats.leaves());
         assert_eq!(b.stats.exact as usize, set.len());
     }
@@ -235,7 +271,10 @@ fn stable_evaluator_never_returns_nan_or_inf() {
             }
             for x in xs {
                 let s = eval::evaluate(&[&set], x, &p);
-                assert!(s.s.is_finite() && s.grad.is_finite(), "{kind} alpha*diag {ad} at {x}: {s:?}");
+                assert!(
+                    s.s.is_finite() && s.grad.is_finite(),
+                    "{kind} alpha*diag {ad} at {x}: {s:?}"
+                );
             }
         }
     }

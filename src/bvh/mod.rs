@@ -64,7 +64,11 @@ impl Bvh {
                 1 + rec(nodes, i + 1).max(rec(nodes, n.index as usize))
             }
         }
-        if self.nodes.is_empty() { 0 } else { rec(&self.nodes, 0) }
+        if self.nodes.is_empty() {
+            0
+        } else {
+            rec(&self.nodes, 0)
+        }
     }
 
     pub fn leaf_count(&self) -> usize {

@@ -8,7 +8,10 @@ use crate::mesh::Aabb;
 pub fn validate(bvh: &Bvh, bounds: &[Aabb]) -> Result<(), String> {
     let n = bounds.len();
     if bvh.order.len() != n {
-        return Err(format!("order has {} entries for {n} primitives", bvh.order.len()));
+        return Err(format!(
+            "order has {} entries for {n} primitives",
+            bvh.order.len()
+        ));
     }
     let mut seen = vec![false; n];
     for &o in &bvh.order {
@@ -25,9 +28,7 @@ pub fn validate(bvh: &Bvh, bounds: &[Aabb]) -> Result<(), String> {
     let mut stack = vec![0usize];
     while let Some(i) = stack.pop() {
         let node = bvh.nodes.get(i).ok_or(format!("node {i} out of range"))?;
-        let contains = |b: &Aabb| {
-            node.min.cmple(b.min).all() && node.max.cmpge(b.max).all()
-        };
+        let contains = |b: &Aabb| node.min.cmple(b.min).all() && node.max.cmpge(b.max).all();
         if node.is_leaf() {
             let (f, c) = (node.index as usize, node.count as usize);
             if f + c > n || c as u32 != node.size {
@@ -49,7 +50,10 @@ pub fn validate(bvh: &Bvh, bounds: &[Aabb]) -> Result<(), String> {
                 return Err(format!("node {i} size {} != children sum", node.size));
             }
             for ch in [ln, rn] {
-                if !contains(&Aabb { min: ch.min, max: ch.max }) {
+                if !contains(&Aabb {
+                    min: ch.min,
+                    max: ch.max,
+                }) {
                     return Err(format!("node {i} does not contain its child"));
                 }
             }

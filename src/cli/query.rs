@@ -18,7 +18,11 @@ pub struct QueryArgs {
     #[arg(long, short, value_delimiter = ',', required = true)]
     primitive: Vec<PrimitiveKind>,
     /// Sharpness alpha (1/length).
-    #[arg(long, conflicts_with = "alpha_rel", required_unless_present = "alpha_rel")]
+    #[arg(
+        long,
+        conflicts_with = "alpha_rel",
+        required_unless_present = "alpha_rel"
+    )]
     alpha: Option<f64>,
     /// Sharpness relative to the bounding-box diagonal: alpha = ALPHA_REL / diagonal.
     #[arg(long)]
@@ -54,7 +58,8 @@ pub fn run(a: QueryArgs) -> Result<()> {
     let diag = mesh.bounds().diagonal();
     let alpha = resolve_alpha("alpha", a.alpha, a.alpha_rel, diag)?
         .context("give --alpha or --alpha-rel")?;
-    let max_alpha = resolve_alpha("max-alpha", a.max_alpha, a.max_alpha_rel, diag)?.unwrap_or(alpha);
+    let max_alpha =
+        resolve_alpha("max-alpha", a.max_alpha, a.max_alpha_rel, diag)?.unwrap_or(alpha);
     let mut params = EvalParams::new(alpha, max_alpha, a.beta);
     if a.naive {
         params.accumulation = Accumulation::Naive;
@@ -64,7 +69,11 @@ pub fn run(a: QueryArgs) -> Result<()> {
         "{}: {} {} ({} primitives), diagonal {diag}, alpha {alpha} (alpha * diagonal = {}), max_alpha {max_alpha}, beta {}, {} accumulation",
         a.mesh.display(),
         mesh.name,
-        a.primitive.iter().map(|k| k.name()).collect::<Vec<_>>().join("+"),
+        a.primitive
+            .iter()
+            .map(|k| k.name())
+            .collect::<Vec<_>>()
+            .join("+"),
         n,
         alpha * diag,
         a.beta,
@@ -132,7 +141,8 @@ fn read_points(path: Option<&PathBuf>) -> Result<Vec<DVec3>> {
         Some(p) => (
             p.display().to_string(),
             Box::new(std::io::BufReader::new(
-                std::fs::File::open(p).with_context(|| format!("{}: cannot open query points", p.display()))?,
+                std::fs::File::open(p)
+                    .with_context(|| format!("{}: cannot open query points", p.display()))?,
             )),
         ),
         None => ("<stdin>".into(), Box::new(std::io::stdin().lock())),
@@ -148,12 +158,24 @@ fn read_points(path: Option<&PathBuf>) -> Result<Vec<DVec3>> {
             .split_whitespace()
             .map(|w| w.parse::<f64>())
             .collect::<Result<_, _>>()
-            .map_err(|_| anyhow::anyhow!("{name}:{}: expected three numbers `x y z`, got `{t}`", i + 1))?;
+            .map_err(|_| {
+                anyhow::anyhow!(
+                    "{name}:{}: expected three numbers `x y z`, got `{t}`",
+                    i + 1
+                )
+            })?;
         if v.len() != 3 {
-            bail!("{name}:{}: expected three numbers `x y z`, got {} values", i + 1, v.len());
+            bail!(
+                "{name}:{}: expected three numbers `x y z`, got {} values",
+                i + 1,
+                v.len()
+            );
         }
         if v.iter().any(|c| !c.is_finite()) {
-            bail!("{name}:{}: query coordinates must be finite, got `{t}`", i + 1);
+            bail!(
+                "{name}:{}: query coordinates must be finite, got `{t}`",
+                i + 1
+            );
         }
         out.push(DVec3::new(v[0], v[1], v[2]));
     }

@@ -70,7 +70,21 @@ impl Accumulator {
         }
     }
 
-    /// `(s, grad s, underflow)`. With no term at all, `s = +inf`.
+    /// Adds the term `w exp(-alpha d)` to the value sums only (no gradient).
+    #[inline]
+    pub fn add_value(&mut self, d: f64, w: f64) {
+        if d < self.m {
+            let rescale = (-self.alpha * (self.m - d)).exp();
+            self.s *= rescale;
+            self.m = d;
+        }
+        self.s += w * (-self.alpha * (d - self.m)).exp();
+        if self.naive {
+            self.naive_s += w * (-self.alpha * d).exp();
+        }
+    }
+
+    /// `(s, grad s, underflow)` (the gradient is zero if only `add_value` was used). With no term at all, `s = +inf`.
     pub fn finish(&self) -> (f64, DVec3, bool) {
         if self.naive {
             if self.naive_s > 0.0 {
@@ -104,9 +118,16 @@ mod tests {
             }
             let (s, g, under) = acc.finish();
             let m = 1.0;
-            let want = m
-                - d.iter().map(|&di| (-alpha * (di - m)).exp()).sum::<f64>().ln() / alpha;
-            assert!((s - want).abs() <= 1e-14 * want.abs().max(1.0), "{s} vs {want}");
+            let want = m - d
+                .iter()
+                .map(|&di| (-alpha * (di - m)).exp())
+                .sum::<f64>()
+                .ln()
+                / alpha;
+            assert!(
+                (s - want).abs() <= 1e-14 * want.abs().max(1.0),
+                "{s} vs {want}"
+            );
             assert!((g - DVec3::X).length() < 1e-12 && !under);
         }
     }

@@ -6,7 +6,12 @@ use crate::primitives::{AnySet, Primitive, PrimitiveSet, WeightScale};
 use glam::DVec3;
 
 /// `(s, grad s, d_min)` by brute force over all primitives of `sets`.
-pub fn smooth_distance(sets: &[&AnySet], x: DVec3, alpha: f64, max_alpha: f64) -> (f64, DVec3, f64) {
+pub fn smooth_distance(
+    sets: &[&AnySet],
+    x: DVec3,
+    alpha: f64,
+    max_alpha: f64,
+) -> (f64, DVec3, f64) {
     let mut terms = Vec::new();
     for set in sets {
         crate::with_set!(set, s => collect(s, x, alpha, max_alpha, &mut terms));

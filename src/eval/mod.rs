@@ -13,4 +13,4 @@ pub mod smooth;
 
 pub use accumulate::Accumulation;
 pub use nearest::{Nearest, nearest};
-pub use smooth::{EvalParams, EvalStats, Sample, evaluate};
+pub use smooth::{EvalParams, EvalStats, Sample, evaluate, evaluate_value};

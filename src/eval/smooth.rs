@@ -89,8 +89,18 @@ pub struct Sample {
     pub stats: EvalStats,
 }
 
-/// Evaluates the smooth distance of the union of `sets` at `x`.
+/// Evaluates the smooth distance of the union of `sets` at `x`, with its gradient.
 pub fn evaluate(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
+    evaluate_impl::<true>(sets, x, p)
+}
+
+/// Evaluates the smooth distance only (the returned gradient is zero): what a sphere
+/// tracer needs for its steps, at about half the cost.
+pub fn evaluate_value(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
+    evaluate_impl::<false>(sets, x, p)
+}
+
+fn evaluate_impl<const GRAD: bool>(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
     let mut acc = Accumulator::new(p.alpha, p.accumulation);
     let mut stats = EvalStats::default();
     let total: usize = sets.iter().map(|s| s.len()).sum();
@@ -109,7 +119,7 @@ pub fn evaluate(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
         f64::INFINITY
     };
     for (set, scale) in sets.iter().zip(&scales) {
-        crate::with_set!(set, s => traverse(s, x, p, scale, prune_margin, &mut acc, &mut stats));
+        crate::with_set!(set, s => traverse::<_, GRAD>(s, x, p, scale, prune_margin, &mut acc, &mut stats));
     }
     let (s, grad, underflow) = acc.finish();
     Sample {
@@ -125,7 +135,7 @@ pub fn evaluate(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
 /// fits in memory (binned SAH with a median fallback).
 const STACK: usize = 128;
 
-fn traverse<P: Primitive>(
+fn traverse<P: Primitive, const GRAD: bool>(
     set: &PrimitiveSet<P>,
     x: DVec3,
     p: &EvalParams,
@@ -154,16 +164,24 @@ fn traverse<P: Primitive>(
         if node.is_leaf() {
             let first = node.index as usize;
             for prim in &set.prims[first..first + node.count as usize] {
-                let t = prim.term(x, scale);
-                acc.add(t.d, t.w, t.dir, t.grad_w);
+                if GRAD {
+                    let t = prim.term(x, scale);
+                    acc.add(t.d, t.w, t.dir, t.grad_w);
+                } else {
+                    let (d, w) = prim.value(x, scale);
+                    acc.add_value(d, w);
+                }
             }
             stats.exact += node.count;
             continue;
         }
         if p.beta > 0.0 && (node.diam as f64) < p.beta * r {
-            let (_, c) = node.distance(x);
-            let dir = (x - c) / r;
-            acc.add(r, node.size as f64 * w_ff, dir, DVec3::ZERO);
+            if GRAD {
+                let (_, c) = node.distance(x);
+                acc.add(r, node.size as f64 * w_ff, (x - c) / r, DVec3::ZERO);
+            } else {
+                acc.add_value(r, node.size as f64 * w_ff);
+            }
             stats.far += 1;
             continue;
         }

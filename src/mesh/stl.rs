@@ -3,5 +3,8 @@ use super::{Mesh, MeshError};
 use std::path::Path;
 
 pub(super) fn read_stl(path: &Path) -> Result<Mesh, MeshError> {
-    Err(MeshError::Format { path: path.to_path_buf(), message: "reader not written yet".into() })
+    Err(MeshError::Format {
+        path: path.to_path_buf(),
+        message: "reader not written yet".into(),
+    })
 }

@@ -27,7 +27,10 @@ pub trait Primitive: Copy + Send + Sync + 'static {
     fn bounds(&self) -> Aabb;
     fn centroid(&self) -> Vec3;
     fn closest_point(&self, x: DVec3) -> DVec3;
+    /// The full term, with the direction and the weight gradient.
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term;
+    /// `(d, w)` only: what a value-only evaluation (sphere-tracing steps) needs.
+    fn value(&self, x: DVec3, scale: &WeightScale) -> (f64, f64);
 }
 
 #[inline]
@@ -53,6 +56,10 @@ impl Primitive for Point {
     }
     fn closest_point(&self, _x: DVec3) -> DVec3 {
         self.p.as_dvec3()
+    }
+    #[inline]
+    fn value(&self, x: DVec3, _scale: &WeightScale) -> (f64, f64) {
+        ((x - self.p.as_dvec3()).length(), 1.0)
     }
     #[inline]
     fn term(&self, x: DVec3, _scale: &WeightScale) -> Term {
@@ -89,6 +96,13 @@ impl Primitive for Edge {
     }
     fn closest_point(&self, x: DVec3) -> DVec3 {
         closest_on_segment(x, self.a.as_dvec3(), self.b.as_dvec3()).point
+    }
+    #[inline]
+    fn value(&self, x: DVec3, scale: &WeightScale) -> (f64, f64) {
+        let (a, b) = (self.a.as_dvec3(), self.b.as_dvec3());
+        let c = closest_on_segment(x, a, b);
+        let coef = weights::edge_quartic(1.0 / self.val_a as f64, 1.0 / self.val_b as f64);
+        ((x - c.point).length(), scale.weight(weights::edge_w(c.t, coef).0))
     }
     #[inline]
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term {
@@ -140,12 +154,23 @@ impl Primitive for Triangle {
         closest_on_triangle(x, self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3()).point
     }
     #[inline]
+    fn value(&self, x: DVec3, scale: &WeightScale) -> (f64, f64) {
+        let (a, b, c) = (self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3());
+        let cl = closest_on_triangle(x, a, b, c);
+        let mut buf = [0.0; 13];
+        let k = weights::triangle_k(self.vmax, self.emax, &mut buf);
+        let raw = weights::triangle_w_value(cl.s, cl.t, k);
+        ((x - cl.point).length(), scale.weight(raw))
+    }
+    #[inline]
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term {
         let (a, b, c) = (self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3());
         let cl = closest_on_triangle(x, a, b, c);
         let v = x - cl.point;
         let d = v.length();
-        let (raw, ws, wt) = weights::triangle_w(cl.s, cl.t, self.vmax as f64, self.emax as f64);
+        let mut buf = [0.0; 13];
+        let k = weights::triangle_k(self.vmax, self.emax, &mut buf);
+        let (raw, ws, wt) = weights::triangle_w_grad(cl.s, cl.t, k);
         let (w, dw) = scale.apply(raw);
         let grad_w = if dw != 0.0 {
             let (gs, gt) = weights::triangle_bary_gradients(cl.feature, b - a, c - a);

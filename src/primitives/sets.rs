@@ -125,8 +125,8 @@ impl AnySet {
                 AnySet::Edges(PrimitiveSet::new(prims, max_adj, options, secs(t)))
             }
             PrimitiveKind::Triangles => {
-                let (prims, max_adj) = triangles(mesh)
-                    .ok_or_else(|| err("it has no faces; use points or edges"))?;
+                let (prims, max_adj) =
+                    triangles(mesh).ok_or_else(|| err("it has no faces; use points or edges"))?;
                 AnySet::Triangles(PrimitiveSet::new(prims, max_adj, options, secs(t)))
             }
         })
@@ -242,7 +242,12 @@ fn triangles(mesh: &Mesh) -> Option<(Vec<Triangle>, f64)> {
         .triangles
         .iter()
         .map(|t| {
-            let vmax = t.iter().map(|&i| vval[i as usize]).max().unwrap_or(1).max(1);
+            let vmax = t
+                .iter()
+                .map(|&i| vval[i as usize])
+                .max()
+                .unwrap_or(1)
+                .max(1);
             let emax = [key(t[0], t[1]), key(t[1], t[2]), key(t[2], t[0])]
                 .into_iter()
                 .map(count_of)

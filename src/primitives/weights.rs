@@ -107,28 +107,90 @@ pub fn tri_basis(s: f64, t: f64) -> ([f64; 13], [f64; 13]) {
     (value, ds)
 }
 
-/// Unclamped triangle weight polynomial `W(s, t)` and its partials `(dW/ds, dW/dt)` for
-/// a triangle whose largest vertex valence is `vmax` and largest edge valence `emax`.
-/// An isolated triangle (`vmax = 1`) has `W = 1` (SPEC 4's trap: the centroid value
-/// `(vmax-1)/vmax` would be 0).
-#[inline]
-pub fn triangle_w(s: f64, t: f64, vmax: f64, emax: f64) -> (f64, f64, f64) {
+/// Coefficients `k` of the triangle weight for a triangle whose largest vertex valence
+/// is `vmax` and largest edge valence `emax`: `k = A/vmax + B/emax + C (vmax-1)/vmax`.
+/// An isolated triangle (`vmax = 1`) gets `W = 1` (SPEC 4's trap: the centroid value
+/// `(vmax-1)/vmax` would be 0 and leave a hole).
+pub fn triangle_coefficients(vmax: f64, emax: f64) -> [f64; 13] {
+    let mut k = [0.0; 13];
     if vmax <= 1.0 {
-        return (1.0, 0.0, 0.0);
+        k[0] = 1.0;
+        return k;
     }
     let (fa, fb, fc) = (1.0 / vmax, 1.0 / emax, (vmax - 1.0) / vmax);
+    for i in 0..13 {
+        k[i] = fa * TRI_A[i] + fb * TRI_B[i] + fc * TRI_C[i];
+    }
+    k
+}
+
+const TABLE_VMAX: usize = 32;
+const TABLE_EMAX: usize = 8;
+
+/// [`triangle_coefficients`], from a table computed once for the common valences
+/// (`vmax <= 32`, `emax <= 8`), else into `buf`.
+#[inline]
+pub fn triangle_k(vmax: f32, emax: f32, buf: &mut [f64; 13]) -> &[f64; 13] {
+    static TABLE: std::sync::OnceLock<Vec<[f64; 13]>> = std::sync::OnceLock::new();
+    let (v, e) = (vmax as usize, emax as usize);
+    if (1..=TABLE_VMAX).contains(&v) && (1..=TABLE_EMAX).contains(&e) {
+        let table = TABLE.get_or_init(|| {
+            (1..=TABLE_VMAX)
+                .flat_map(|v| (1..=TABLE_EMAX).map(move |e| triangle_coefficients(v as f64, e as f64)))
+                .collect()
+        });
+        &table[(v - 1) * TABLE_EMAX + (e - 1)]
+    } else {
+        *buf = triangle_coefficients(vmax as f64, emax as f64);
+        buf
+    }
+}
+
+/// Triangle weight polynomial `W(s, t)` (unclamped) with coefficients `k`.
+#[inline]
+pub fn triangle_w_value(s: f64, t: f64, k: &[f64; 13]) -> f64 {
+    let (s2, t2) = (s * s, t * t);
+    let (s3, t3) = (s2 * s, t2 * t);
+    let (s4, t4) = (s3 * s, t3 * t);
+    let (s5, t5) = (s4 * s, t4 * t);
+    let (s6, t6) = (s5 * s, t5 * t);
+    let q = s2 * t2;
+    let c = s3 * t3;
+    let p2 = s2 + t2;
+    let p3 = s3 + t3;
+    k[0] + k[1] * p2
+        + k[2] * p3
+        + k[3] * (s4 + t4)
+        + k[4] * q
+        + k[5] * (s5 + t5)
+        + k[6] * q * (s + t)
+        + k[7] * (s6 + t6)
+        + k[8] * q * p2
+        + k[9] * c
+        + k[10] * (s6 * s + t6 * t)
+        + k[11] * q * p3
+        + k[12] * c * (s + t)
+}
+
+/// Triangle weight polynomial and its partials `(W, dW/ds, dW/dt)` with coefficients `k`.
+#[inline]
+pub fn triangle_w_grad(s: f64, t: f64, k: &[f64; 13]) -> (f64, f64, f64) {
     let (bs, dbs) = tri_basis(s, t);
     let (_, dbt) = tri_basis(t, s);
     let mut w = 0.0;
     let mut ws = 0.0;
     let mut wt = 0.0;
     for i in 0..13 {
-        let k = fa * TRI_A[i] + fb * TRI_B[i] + fc * TRI_C[i];
-        w += k * bs[i];
-        ws += k * dbs[i];
-        wt += k * dbt[i];
+        w += k[i] * bs[i];
+        ws += k[i] * dbs[i];
+        wt += k[i] * dbt[i];
     }
     (w, ws, wt)
+}
+
+/// `(W, dW/ds, dW/dt)` for a triangle with valences `vmax`, `emax` (tests, reports).
+pub fn triangle_w(s: f64, t: f64, vmax: f64, emax: f64) -> (f64, f64, f64) {
+    triangle_w_grad(s, t, &triangle_coefficients(vmax, emax))
 }
 
 /// Coefficients `(c0, c2, c3, c4)` of the edge quartic `W(t) = c0 + c2 t² + c3 t³ + c4 t⁴`
@@ -179,7 +241,25 @@ impl WeightScale {
 
     #[inline]
     fn pow(&self, v: f64) -> f64 {
-        if self.q == 1.0 { v } else { v.powf(self.q) }
+        if self.q == 1.0 {
+            v
+        } else if self.q == 0.5 {
+            v.sqrt()
+        } else {
+            v.powf(self.q)
+        }
+    }
+
+    /// `w` alone for the raw polynomial value `raw` (same as `apply(raw).0`).
+    #[inline]
+    pub fn weight(&self, raw: f64) -> f64 {
+        if raw <= 1.0 / self.max_adj {
+            1.0
+        } else if raw >= 1.0 || raw.is_nan() {
+            self.max_weight()
+        } else {
+            self.pow(self.max_adj * raw)
+        }
     }
 
     /// `(w, dw/dW)` for the raw polynomial value `raw`.
@@ -271,7 +351,12 @@ mod tests {
             assert!(wt.abs() < 1e-9, "dW/dt at ({u},0) = {wt}");
             // Across s + t = 1 the normal direction is (1, 1).
             let (_, ws, wt) = triangle_w(u, 1.0 - u, vmax, emax);
-            assert!((ws + wt).abs() < 1e-6, "dW/dn at ({u},{}) = {}", 1.0 - u, ws + wt);
+            assert!(
+                (ws + wt).abs() < 1e-6,
+                "dW/dn at ({u},{}) = {}",
+                1.0 - u,
+                ws + wt
+            );
             // Numerically too, with a one-sided difference into the triangle.
             let h = 1e-6;
             let (w0, _, _) = triangle_w(0.0, u * 0.999, vmax, emax);
@@ -291,7 +376,10 @@ mod tests {
                 hi = hi.max(w);
             }
         }
-        assert!((lo - 0.1665).abs() < 2e-3 && (hi - 0.850).abs() < 2e-3, "[{lo}, {hi}]");
+        assert!(
+            (lo - 0.1665).abs() < 2e-3 && (hi - 0.850).abs() < 2e-3,
+            "[{lo}, {hi}]"
+        );
     }
 
     #[test]
@@ -299,9 +387,29 @@ mod tests {
         let h = 1e-6;
         for &(s, t) in &[(0.2, 0.3), (0.6, 0.1), (0.1, 0.8)] {
             let (_, ws, wt) = triangle_w(s, t, 7.0, 2.0);
-            let fs = (triangle_w(s + h, t, 7.0, 2.0).0 - triangle_w(s - h, t, 7.0, 2.0).0) / (2.0 * h);
-            let ft = (triangle_w(s, t + h, 7.0, 2.0).0 - triangle_w(s, t - h, 7.0, 2.0).0) / (2.0 * h);
+            let fs =
+                (triangle_w(s + h, t, 7.0, 2.0).0 - triangle_w(s - h, t, 7.0, 2.0).0) / (2.0 * h);
+            let ft =
+                (triangle_w(s, t + h, 7.0, 2.0).0 - triangle_w(s, t - h, 7.0, 2.0).0) / (2.0 * h);
             assert!((ws - fs).abs() < 1e-6 && (wt - ft).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn value_path_matches_gradient_path_and_table() {
+        let mut buf = [0.0; 13];
+        for (v, e) in [(1.0f32, 1.0f32), (6.0, 2.0), (40.0, 3.0), (5.0, 12.0)] {
+            let k = *triangle_k(v, e, &mut buf);
+            assert_eq!(k, triangle_coefficients(v as f64, e as f64));
+            for &(s, t) in &[(0.1, 0.2), (0.5, 0.5), (0.0, 1.0), (0.3, 0.0)] {
+                let a = triangle_w_value(s, t, &k);
+                let b = triangle_w_grad(s, t, &k).0;
+                assert!((a - b).abs() < 1e-12, "{a} vs {b}");
+            }
+        }
+        let ws = WeightScale::new(6.0, 1.0, 2.0);
+        for raw in [0.1, 0.3, 0.9] {
+            assert_eq!(ws.weight(raw), ws.apply(raw).0);
         }
     }
 

@@ -79,7 +79,7 @@ pub fn render(
     };
     let origin = camera.origin();
     let mut probe = Default::default();
-    let (s0, _, _) = tracer.field(origin, &mut probe);
+    let (s0, _) = tracer.field(origin, &mut probe);
     let mut image = RgbImage::from_pixel(w, h, image::Rgb(background));
     let mut depth = vec![f32::INFINITY; (w * h) as usize];
     if s0 <= 0.0 {

@@ -53,10 +53,14 @@ impl TraceObject {
     }
 
     /// Evaluates the smooth distance with the object's parameters (alpha possibly
-    /// replaced, for the naive mode's falloff).
-    pub fn evaluate(&self, sets: &[&AnySet], x: DVec3, alpha: f64) -> Sample {
+    /// replaced, for the naive mode's falloff), with the gradient if `grad`.
+    pub fn evaluate(&self, sets: &[&AnySet], x: DVec3, alpha: f64, grad: bool) -> Sample {
         let mut p = self.params;
         p.alpha = alpha;
-        eval::evaluate(sets, x, &p)
+        if grad {
+            eval::evaluate(sets, x, &p)
+        } else {
+            eval::evaluate_value(sets, x, &p)
+        }
     }
 }

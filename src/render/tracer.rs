@@ -13,7 +13,9 @@
 //!    is not a lower bound of the distance to its own zero set) is backtracked: the
 //!    crossing is bracketed by the last positive `t` and this one and found by the
 //!    Illinois (safeguarded regula falsi) method to within `epsilon`.
-//! 5. The normal is the normalised gradient at the hit.
+//! 5. The normal is the normalised gradient at the hit. Steps need only the value, so
+//!    they use value-only evaluations; one evaluation with the gradient is made at the
+//!    hit (the ideal ray costs one such evaluation plus its steps).
 
 use super::object::TraceObject;
 use crate::eval::EvalStats;
@@ -62,9 +64,9 @@ pub struct RayResult {
     pub stats: RayStats,
 }
 
+#[derive(Clone, Copy)]
 struct FieldSample {
     s: f64,
-    grad: DVec3,
     object: usize,
 }
 
@@ -102,16 +104,31 @@ impl<'a> Tracer<'a> {
         &self.options
     }
 
-    /// The scene field at `x`: the minimum over objects.
-    pub fn field(&self, x: DVec3, stats: &mut RayStats) -> (f64, DVec3, usize) {
+    /// The scene field at `x` (the minimum over objects) and the object attaining it.
+    pub fn field(&self, x: DVec3, stats: &mut RayStats) -> (f64, usize) {
         let f = self.sample(x, stats);
-        (f.s, f.grad, f.object)
+        (f.s, f.object)
+    }
+
+    /// The gradient of object `k`'s smooth distance at `x` (one evaluation).
+    pub fn gradient(&self, k: usize, x: DVec3, stats: &mut RayStats) -> DVec3 {
+        let obj = &self.objects[k];
+        let mut alpha = obj.params.alpha;
+        loop {
+            let sample = obj.evaluate(&self.sets[k], x, alpha, true);
+            stats.evals += 1;
+            stats.eval.add(&sample.stats);
+            if sample.s.is_finite() || alpha <= 1e-300 {
+                return sample.grad;
+            }
+            alpha /= 10.0;
+            stats.falloffs += 1;
+        }
     }
 
     fn sample(&self, x: DVec3, stats: &mut RayStats) -> FieldSample {
         let mut best = FieldSample {
             s: f64::INFINITY,
-            grad: DVec3::ZERO,
             object: 0,
         };
         for (k, obj) in self.objects.iter().enumerate() {
@@ -119,13 +136,13 @@ impl<'a> Tracer<'a> {
                 continue;
             }
             let mut alpha = obj.params.alpha;
-            let mut sample = obj.evaluate(&self.sets[k], x, alpha);
+            let mut sample = obj.evaluate(&self.sets[k], x, alpha, false);
             stats.evals += 1;
             stats.eval.add(&sample.stats);
             // Alpha falloff (naive mode): a smaller alpha gives a smaller, finite s.
             while sample.s == f64::INFINITY && alpha > 1e-300 {
                 alpha /= 10.0;
-                sample = obj.evaluate(&self.sets[k], x, alpha);
+                sample = obj.evaluate(&self.sets[k], x, alpha, false);
                 stats.falloffs += 1;
                 stats.evals += 1;
                 stats.eval.add(&sample.stats);
@@ -133,7 +150,6 @@ impl<'a> Tracer<'a> {
             if sample.s < best.s {
                 best = FieldSample {
                     s: sample.s,
-                    grad: sample.grad,
                     object: k,
                 };
             }
@@ -170,8 +186,9 @@ impl<'a> Tracer<'a> {
             }
             let f = self.sample(o + t * d, &mut stats);
             if f.s.abs() <= eps {
+                let hit = self.hit(o, d, t, &f, &mut stats);
                 return RayResult {
-                    hit: Some(self.hit(o, d, t, &f)),
+                    hit: Some(hit),
                     stats,
                 };
             }
@@ -179,7 +196,7 @@ impl<'a> Tracer<'a> {
                 let hit = match prev {
                     Some((tp, sp)) => self.backtrack(o, d, (tp, sp), (t, f.s), &mut stats),
                     // Negative at the first sample: the ray starts inside the band.
-                    None => Some(self.hit(o, d, t, &f)),
+                    None => Some(self.hit(o, d, t, &f, &mut stats)),
                 };
                 return RayResult { hit, stats };
             }
@@ -189,11 +206,12 @@ impl<'a> Tracer<'a> {
         RayResult { hit: None, stats }
     }
 
-    fn hit(&self, o: DVec3, d: DVec3, t: f64, f: &FieldSample) -> Hit {
+    fn hit(&self, o: DVec3, d: DVec3, t: f64, f: &FieldSample, stats: &mut RayStats) -> Hit {
+        let point = o + t * d;
         Hit {
             t,
-            point: o + t * d,
-            normal: f.grad.normalize_or_zero(),
+            point,
+            normal: self.gradient(f.object, point, stats).normalize_or_zero(),
             object: f.object,
         }
     }
@@ -222,11 +240,10 @@ impl<'a> Tracer<'a> {
             let before = stats.evals;
             let f = self.sample(o + t * d, stats);
             stats.backtracks += stats.evals - before;
-            let h = self.hit(o, d, t, &f);
             if f.s.abs() <= eps || hi - lo <= eps {
-                return Some(h);
+                return Some(self.hit(o, d, t, &f, stats));
             }
-            last = Some(h);
+            last = Some((t, f));
             if f.s > 0.0 {
                 lo = t;
                 s_lo = f.s;
@@ -243,6 +260,6 @@ impl<'a> Tracer<'a> {
                 side = -1;
             }
         }
-        last
+        last.map(|(t, f)| self.hit(o, d, t, &f, stats))
     }
 }

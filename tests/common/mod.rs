@@ -96,7 +96,9 @@ pub fn random_wire(rng: &mut Rng, polylines: usize, len: usize) -> Mesh {
 
 /// Path of a shared data file, or `None` (with a printed reason) when `data/` is absent.
 pub fn data_file(name: &str) -> Option<PathBuf> {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data").join(name);
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("data")
+        .join(name);
     if p.exists() {
         Some(p)
     } else {
