@@ -49,6 +49,13 @@ fn check_against_brute(mesh: &Mesh, kinds: &[PrimitiveKind], alpha_diag: &[f64],
             let p = EvalParams::new(alpha, max_alpha, 0.0);
             for &x in &qs {
                 let got = eval::evaluate(&refs, x, &p);
+                let value_only = eval::evaluate_value(&refs, x, &p);
+                assert!(
+                    (got.s - value_only.s).abs() <= 1e-12 * s_scale(got.s, alpha),
+                    "value-only evaluation {} differs from {} at {x}",
+                    value_only.s,
+                    got.s
+                );
                 let (s, g, dmin) = brute::smooth_distance(&refs, x, alpha, max_alpha);
                 let tol = 1e-6 * s_scale(s, alpha);
                 assert!(
@@ -131,6 +138,8 @@ fn barnes_hut_never_exceeds_exact_and_is_conservative() {
                 for beta in [0.1, 0.5, 1.0] {
                     let p = EvalParams::new(alpha, alpha, beta);
                     let sb = eval::evaluate(&[&set], x, &p).s;
+                    let sv = eval::evaluate_value(&[&set], x, &p).s;
+                    assert!((sb - sv).abs() <= 1e-12 * s_scale(sb, alpha), "{sb} vs {sv}");
                     // Pruning may raise either value by at most 1e-14 / alpha.
                     assert!(
                         sb <= s0 + 1e-12 / alpha,
