@@ -1,10 +1,400 @@
-//! PLY reader (being written).
+//! PLY reader over `ply-rs-bw`: ASCII, binary little-endian and binary big-endian.
+//!
+//! Supported elements (others are read and skipped):
+//! - `vertex` (required): scalar properties `x`, `y`, `z` of any scalar type (`char` ..
+//!   `double`, converted to `f32`); other vertex properties (normals, colours, list
+//!   properties) are ignored.
+//! - `face` (optional): a list property `vertex_indices` or `vertex_index` with an
+//!   integer item type; polygons of any size >= 3 are fan-triangulated into
+//!   [`Mesh::triangles`].
+//! - `edge` (optional): integer scalar properties `vertex1` and `vertex2`, giving
+//!   [`Mesh::segments`].
+//!
+//! Elements are parsed into small typed structs (ply-rs-bw's `PropertyAccess`), not its
+//! `DefaultElement` hash maps: 8 M float vertices parse in about 0.2 s in release. (A
+//! hand-written fixed-stride decoder of binary vertex blocks was tried and saved only
+//! about 70 ms of that, so there is a single path.)
+//!
+//! Header errors and ASCII payload errors carry the 1-based line ([`MeshError::Parse`]);
+//! binary payload errors (a truncated file) are [`MeshError::Format`].
+
 use super::{Mesh, MeshError};
+use glam::Vec3;
+use ply_rs_bw::parser::{ParseError, Parser, Reader};
+use ply_rs_bw::ply::{
+    BeginList, Encoding, Header, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType,
+};
 use std::path::Path;
 
 pub(super) fn read_ply(path: &Path) -> Result<Mesh, MeshError> {
-    Err(MeshError::Format {
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
         path: path.to_path_buf(),
-        message: "reader not written yet".into(),
+        source,
+    })?;
+    parse_ply(&bytes, path)
+}
+
+/// Names of the face list property we accept (a face element with both is rejected).
+const FACE_LIST_NAMES: [&str; 2] = ["vertex_indices", "vertex_index"];
+
+/// Parses a whole PLY file held in `bytes`; `path` is only used in errors. (Reading the
+/// file whole was measured faster than streaming it through a `BufReader`, at the cost
+/// of holding the file and the vertices at once: about 200 MB for 8 M points.)
+fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
+    let format_err = |message: String| MeshError::Format {
+        path: path.to_path_buf(),
+        message,
+    };
+    if bytes.is_empty() {
+        return Err(MeshError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    if !bytes.starts_with(b"ply") {
+        return Err(format_err(
+            "not a PLY file (it does not start with 'ply')".into(),
+        ));
+    }
+    let mut reader = Reader::new(bytes);
+    let header = Parser::<Skip>::new()
+        .read_header(&mut reader)
+        .map_err(|e| wrap(path, e, true, "invalid PLY header"))?;
+    check_layout(&header).map_err(format_err)?;
+
+    let ascii = header.encoding == Encoding::Ascii;
+    let mut mesh = Mesh::default();
+    let (mut faces, mut edges) = (Vec::new(), Vec::new());
+    for (name, def) in &header.elements {
+        let context = format!("element '{name}'");
+        let payload_err = |e| wrap(path, e, ascii, &context);
+        match name.as_str() {
+            "vertex" => {
+                // Same size and alignment: the collect reuses the allocation.
+                mesh.vertices = Parser::<PlyVertex>::new()
+                    .read_payload_for_element(&mut reader, def, &header)
+                    .map_err(payload_err)?
+                    .into_iter()
+                    .map(|v| Vec3::from_array(v.0))
+                    .collect();
+            }
+            "face" => {
+                faces = Parser::<PlyFace>::new()
+                    .read_payload_for_element(&mut reader, def, &header)
+                    .map_err(payload_err)?;
+            }
+            "edge" => {
+                edges = Parser::<PlyEdge>::new()
+                    .read_payload_for_element(&mut reader, def, &header)
+                    .map_err(payload_err)?;
+            }
+            _ => {
+                Parser::<Skip>::new()
+                    .read_payload_for_element(&mut reader, def, &header)
+                    .map_err(payload_err)?;
+            }
+        }
+    }
+    // Elements may come in any order, so indices are converted once all are read.
+    let count = mesh.vertices.len();
+    mesh.triangles = triangulate(&faces, count, path)?;
+    mesh.segments = edges
+        .iter()
+        .map(|e| {
+            Ok([
+                to_index(e.0[0], count, path)?,
+                to_index(e.0[1], count, path)?,
+            ])
+        })
+        .collect::<Result<_, MeshError>>()?;
+    Ok(mesh)
+}
+
+/// Checks the header declares what we read, with messages that say what is missing.
+fn check_layout(header: &Header) -> Result<(), String> {
+    let vertex = header
+        .elements
+        .get("vertex")
+        .ok_or("the header declares no 'vertex' element")?;
+    for axis in ["x", "y", "z"] {
+        match vertex.properties.get(axis).map(|p| &p.data_type) {
+            Some(PropertyType::Scalar(_)) => {}
+            Some(PropertyType::List(..)) => {
+                return Err(format!(
+                    "vertex property '{axis}' is a list; x, y and z must be scalars"
+                ));
+            }
+            None => {
+                return Err(format!(
+                    "element 'vertex' has no property '{axis}' (x, y and z are required)"
+                ));
+            }
+        }
+    }
+    if let Some(face) = header.elements.get("face") {
+        let lists: Vec<_> = FACE_LIST_NAMES
+            .iter()
+            .filter_map(|n| face.properties.get(*n))
+            .collect();
+        match lists.as_slice() {
+            [] => {
+                return Err(
+                    "element 'face' has no list property 'vertex_indices' or 'vertex_index'".into(),
+                );
+            }
+            [p] => match &p.data_type {
+                PropertyType::List(_, t) if is_integer(t) => {}
+                other => {
+                    return Err(format!(
+                        "face property '{}' must be a list of integers, found {other:?}",
+                        p.name
+                    ));
+                }
+            },
+            _ => {
+                return Err(
+                    "element 'face' has both 'vertex_indices' and 'vertex_index'; which one \
+                     holds the polygons is ambiguous"
+                        .into(),
+                );
+            }
+        }
+    }
+    if let Some(edge) = header.elements.get("edge") {
+        for name in ["vertex1", "vertex2"] {
+            match edge.properties.get(name).map(|p| &p.data_type) {
+                Some(PropertyType::Scalar(t)) if is_integer(t) => {}
+                Some(other) => {
+                    return Err(format!(
+                        "edge property '{name}' must be an integer scalar, found {other:?}"
+                    ));
+                }
+                None => {
+                    return Err(format!(
+                        "element 'edge' has no property '{name}' (vertex1 and vertex2 are \
+                         required)"
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn is_integer(t: &ScalarType) -> bool {
+    !matches!(t, ScalarType::Float | ScalarType::Double)
+}
+
+/// Fan-triangulates the face lists, rejecting faces of fewer than 3 vertices and
+/// negative indices (indices past the end are caught by [`Mesh::validate`]).
+fn triangulate(faces: &[PlyFace], count: usize, path: &Path) -> Result<Vec<[u32; 3]>, MeshError> {
+    let mut triangles = Vec::with_capacity(faces.iter().map(|f| f.len().saturating_sub(2)).sum());
+    for (i, face) in faces.iter().enumerate() {
+        if face.len() < 3 {
+            return Err(MeshError::Format {
+                path: path.to_path_buf(),
+                message: format!(
+                    "face {i} (counting from 0) has {} vertex indices (a face needs at least 3)",
+                    face.len()
+                ),
+            });
+        }
+        let at = |k: usize| -> Result<u32, MeshError> {
+            match (&face.ints, &face.uints) {
+                (ints, _) if !ints.is_empty() => to_index(i64::from(ints[k]), count, path),
+                (_, uints) => Ok(uints[k]),
+            }
+        };
+        let first = at(0)?;
+        let mut prev = at(1)?;
+        for k in 2..face.len() {
+            let v = at(k)?;
+            triangles.push([first, prev, v]);
+            prev = v;
+        }
+    }
+    Ok(triangles)
+}
+
+/// A PLY index as `u32`; negative or huge values are out of range (indices past the
+/// `count` vertices are left to [`Mesh::validate`]).
+fn to_index(i: i64, count: usize, path: &Path) -> Result<u32, MeshError> {
+    u32::try_from(i).map_err(|_| MeshError::IndexOutOfRange {
+        path: path.to_path_buf(),
+        line: None,
+        index: i,
+        count,
     })
+}
+
+/// Wraps a ply-rs-bw error. Its line numbers are file lines only in the header and in
+/// ASCII payloads (`lines_are_real`); in binary payloads they count elements.
+fn wrap(path: &Path, e: ParseError, lines_are_real: bool, context: &str) -> MeshError {
+    // ply-rs-bw's Display prefixes "Line N: " and spreads details over "\n\t" lines.
+    let text = e.to_string();
+    let text = match (e.line(), text.split_once(": ")) {
+        (Some(_), Some((head, tail))) if head.starts_with("Line ") => tail.to_string(),
+        _ => text,
+    };
+    let text = text.replace(".\n\t", "; ").replace("\n\t", "; ");
+    let message = format!("{context}: {}", text.replace(['\n', '\r'], "").trim_end());
+    match e.line() {
+        Some(line) if lines_are_real => MeshError::Parse {
+            path: path.to_path_buf(),
+            line,
+            message,
+        },
+        _ => MeshError::Format {
+            path: path.to_path_buf(),
+            message,
+        },
+    }
+}
+
+/// An element whose properties are all ignored (unknown elements, and the header).
+struct Skip;
+
+impl PropertyAccess for Skip {
+    fn new() -> Self {
+        Skip
+    }
+}
+
+/// Position of a `vertex` element, whatever the scalar types.
+#[derive(Clone, Copy, Default)]
+struct PlyVertex([f32; 3]);
+
+impl PlyVertex {
+    fn set(&mut self, name: &str, value: f32) -> PropertyAccessResult {
+        let axis = match name {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            _ => return PropertyAccessResult::Ignored,
+        };
+        self.0[axis] = value;
+        PropertyAccessResult::Set
+    }
+}
+
+impl PropertyAccess for PlyVertex {
+    fn new() -> Self {
+        Self::default()
+    }
+    fn set_char(&mut self, name: &str, value: i8) -> PropertyAccessResult {
+        self.set(name, f32::from(value))
+    }
+    fn set_uchar(&mut self, name: &str, value: u8) -> PropertyAccessResult {
+        self.set(name, f32::from(value))
+    }
+    fn set_short(&mut self, name: &str, value: i16) -> PropertyAccessResult {
+        self.set(name, f32::from(value))
+    }
+    fn set_ushort(&mut self, name: &str, value: u16) -> PropertyAccessResult {
+        self.set(name, f32::from(value))
+    }
+    fn set_int(&mut self, name: &str, value: i32) -> PropertyAccessResult {
+        self.set(name, value as f32)
+    }
+    fn set_uint(&mut self, name: &str, value: u32) -> PropertyAccessResult {
+        self.set(name, value as f32)
+    }
+    fn set_float(&mut self, name: &str, value: f32) -> PropertyAccessResult {
+        self.set(name, value)
+    }
+    fn set_double(&mut self, name: &str, value: f64) -> PropertyAccessResult {
+        self.set(name, value as f32)
+    }
+}
+
+/// The vertex list of a `face` element: `int` and `uint` lists are filled in place,
+/// narrower integer types are widened into `ints`.
+#[derive(Default)]
+struct PlyFace {
+    ints: Vec<i32>,
+    uints: Vec<u32>,
+}
+
+impl PlyFace {
+    fn len(&self) -> usize {
+        self.ints.len().max(self.uints.len())
+    }
+    fn widen<T: Into<i32>>(&mut self, name: &str, values: Vec<T>) -> PropertyAccessResult {
+        if !FACE_LIST_NAMES.contains(&name) {
+            return PropertyAccessResult::Ignored;
+        }
+        self.ints = values.into_iter().map(Into::into).collect();
+        PropertyAccessResult::Set
+    }
+}
+
+impl PropertyAccess for PlyFace {
+    fn new() -> Self {
+        Self::default()
+    }
+    fn begin_list_int(&mut self, name: &str, _len: usize) -> BeginList<'_, i32> {
+        if FACE_LIST_NAMES.contains(&name) {
+            BeginList::Fill(&mut self.ints)
+        } else {
+            BeginList::UseSetter
+        }
+    }
+    fn begin_list_uint(&mut self, name: &str, _len: usize) -> BeginList<'_, u32> {
+        if FACE_LIST_NAMES.contains(&name) {
+            BeginList::Fill(&mut self.uints)
+        } else {
+            BeginList::UseSetter
+        }
+    }
+    fn set_list_char(&mut self, name: &str, value: Vec<i8>) -> PropertyAccessResult {
+        self.widen(name, value)
+    }
+    fn set_list_uchar(&mut self, name: &str, value: Vec<u8>) -> PropertyAccessResult {
+        self.widen(name, value)
+    }
+    fn set_list_short(&mut self, name: &str, value: Vec<i16>) -> PropertyAccessResult {
+        self.widen(name, value)
+    }
+    fn set_list_ushort(&mut self, name: &str, value: Vec<u16>) -> PropertyAccessResult {
+        self.widen(name, value)
+    }
+}
+
+/// The two vertex indices of an `edge` element.
+#[derive(Default)]
+struct PlyEdge([i64; 2]);
+
+impl PlyEdge {
+    fn set(&mut self, name: &str, value: i64) -> PropertyAccessResult {
+        let end = match name {
+            "vertex1" => 0,
+            "vertex2" => 1,
+            _ => return PropertyAccessResult::Ignored,
+        };
+        self.0[end] = value;
+        PropertyAccessResult::Set
+    }
+}
+
+impl PropertyAccess for PlyEdge {
+    fn new() -> Self {
+        Self::default()
+    }
+    fn set_char(&mut self, name: &str, value: i8) -> PropertyAccessResult {
+        self.set(name, value.into())
+    }
+    fn set_uchar(&mut self, name: &str, value: u8) -> PropertyAccessResult {
+        self.set(name, value.into())
+    }
+    fn set_short(&mut self, name: &str, value: i16) -> PropertyAccessResult {
+        self.set(name, value.into())
+    }
+    fn set_ushort(&mut self, name: &str, value: u16) -> PropertyAccessResult {
+        self.set(name, value.into())
+    }
+    fn set_int(&mut self, name: &str, value: i32) -> PropertyAccessResult {
+        self.set(name, value.into())
+    }
+    fn set_uint(&mut self, name: &str, value: u32) -> PropertyAccessResult {
+        self.set(name, value.into())
+    }
 }
