@@ -1,11 +1,19 @@
 //! smoothtrace: sphere tracing of smooth (weighted LogSumExp) distance fields of point
 //! clouds, edge meshes and triangle meshes. See `ARCHITECTURE.md` for the data flow and
 //! `SPEC.md` (shared) for the math.
+//!
+//! Data flows one way: [`mesh`] (files, [`procedural`] shapes) -> [`primitives`] (sets
+//! with valences and weights) -> [`bvh`] -> [`eval`] (smooth distance, nearest) ->
+//! [`render`] (tracer, image loop, with [`camera`] and [`matcap`]), configured by
+//! [`scene`] files.
 
 pub mod bvh;
+pub mod camera;
 pub mod eval;
 pub mod geometry;
+pub mod matcap;
 pub mod mesh;
 pub mod primitives;
 pub mod procedural;
 pub mod render;
+pub mod scene;

@@ -5,3 +5,4 @@ pub mod tracer;
 
 pub use object::TraceObject;
 pub use tracer::{Hit, RayResult, RayStats, Tracer, TracerOptions};
+pub mod image;
