@@ -33,13 +33,16 @@ fn queries(mesh: &Mesh, n: usize) -> Vec<DVec3> {
     let diag = b.diagonal();
     let mut seed = 0x5EEDu64;
     let mut rnd = move || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (seed >> 11) as f64 / (1u64 << 53) as f64
     };
     (0..n)
         .map(|i| {
             if i % 2 == 0 {
-                let v = mesh.vertices[(rnd() * mesh.vertices.len() as f64) as usize % mesh.vertices.len()];
+                let v = mesh.vertices
+                    [(rnd() * mesh.vertices.len() as f64) as usize % mesh.vertices.len()];
                 v.as_dvec3() + 0.01 * diag * DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)
             } else {
                 let lo = b.min.as_dvec3() - 0.1 * diag;
@@ -64,7 +67,11 @@ fn main() {
             "{:<10} {:>6} {:>7} {:>5} {:>6} {:>12} {:>12} {:>10}",
             "primitive", "n", "alpha", "beta", "prune", "queries/s", "mean leaves", "mean nodes"
         );
-        for kind in [PrimitiveKind::Points, PrimitiveKind::Edges, PrimitiveKind::Triangles] {
+        for kind in [
+            PrimitiveKind::Points,
+            PrimitiveKind::Edges,
+            PrimitiveKind::Triangles,
+        ] {
             let set = AnySet::build(&mesh, kind).unwrap();
             for alpha in [100.0, 1200.0] {
                 for beta in [0.0, 0.5] {
@@ -78,11 +85,19 @@ fn main() {
                             .map(|&x| eval::evaluate(&[&set], x, &p).stats)
                             .collect();
                         let secs = t.elapsed().as_secs_f64();
-                        let leaves = stats.iter().map(|s| s.leaves() as f64).sum::<f64>() / n as f64;
+                        let leaves =
+                            stats.iter().map(|s| s.leaves() as f64).sum::<f64>() / n as f64;
                         let nodes = stats.iter().map(|s| s.nodes as f64).sum::<f64>() / n as f64;
                         println!(
                             "{:<10} {:>6} {:>7} {:>5} {:>6} {:>12.0} {:>12.1} {:>10.1}",
-                            kind.name(), set.len(), alpha, beta, prune, n as f64 / secs, leaves, nodes
+                            kind.name(),
+                            set.len(),
+                            alpha,
+                            beta,
+                            prune,
+                            n as f64 / secs,
+                            leaves,
+                            nodes
                         );
                         rows.push(format!(
                             "bunny-7k x10,{},{},{alpha},{beta},{prune},{n},{secs},{},{leaves},{nodes}",
@@ -117,7 +132,10 @@ fn main() {
         for (alpha_rel, beta) in [(1000.0, 0.5), (1000.0, 0.0)] {
             let p = EvalParams::new(alpha_rel / diag, alpha_rel / diag, beta);
             let t = Instant::now();
-            let leaves: u64 = qs.par_iter().map(|&x| eval::evaluate(&[&set], x, &p).stats.leaves() as u64).sum();
+            let leaves: u64 = qs
+                .par_iter()
+                .map(|&x| eval::evaluate(&[&set], x, &p).stats.leaves() as u64)
+                .sum();
             let secs = t.elapsed().as_secs_f64();
             println!(
                 "lidar queries: alpha*diag {alpha_rel} beta {beta}: {:.0} queries/s, mean leaves {:.1}",

@@ -139,7 +139,10 @@ fn barnes_hut_never_exceeds_exact_and_is_conservative() {
                     let p = EvalParams::new(alpha, alpha, beta);
                     let sb = eval::evaluate(&[&set], x, &p).s;
                     let sv = eval::evaluate_value(&[&set], x, &p).s;
-                    assert!((sb - sv).abs() <= 1e-12 * s_scale(sb, alpha), "{sb} vs {sv}");
+                    assert!(
+                        (sb - sv).abs() <= 1e-12 * s_scale(sb, alpha),
+                        "{sb} vs {sv}"
+                    );
                     // Pruning may raise either value by at most 1e-14 / alpha.
                     assert!(
                         sb <= s0 + 1e-12 / alpha,

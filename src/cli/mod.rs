@@ -3,6 +3,7 @@
 //! their cause chain and exit status 2.
 
 mod query;
+mod render;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -22,6 +23,8 @@ struct Cli {
 enum Command {
     /// Evaluate the smooth distance, its gradient and the exact distance at query points.
     Query(query::QueryArgs),
+    /// Render a scene file to a PNG image.
+    Render(render::RenderArgs),
 }
 
 /// Parses the command line, runs the command, and maps errors to exit status 2.
@@ -29,6 +32,7 @@ pub fn run() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Query(a) => query::run(a),
+        Command::Render(a) => render::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

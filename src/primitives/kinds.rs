@@ -102,7 +102,10 @@ impl Primitive for Edge {
         let (a, b) = (self.a.as_dvec3(), self.b.as_dvec3());
         let c = closest_on_segment(x, a, b);
         let coef = weights::edge_quartic(1.0 / self.val_a as f64, 1.0 / self.val_b as f64);
-        ((x - c.point).length(), scale.weight(weights::edge_w(c.t, coef).0))
+        (
+            (x - c.point).length(),
+            scale.weight(weights::edge_w(c.t, coef).0),
+        )
     }
     #[inline]
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term {

@@ -136,7 +136,9 @@ pub fn triangle_k(vmax: f32, emax: f32, buf: &mut [f64; 13]) -> &[f64; 13] {
     if (1..=TABLE_VMAX).contains(&v) && (1..=TABLE_EMAX).contains(&e) {
         let table = TABLE.get_or_init(|| {
             (1..=TABLE_VMAX)
-                .flat_map(|v| (1..=TABLE_EMAX).map(move |e| triangle_coefficients(v as f64, e as f64)))
+                .flat_map(|v| {
+                    (1..=TABLE_EMAX).map(move |e| triangle_coefficients(v as f64, e as f64))
+                })
                 .collect()
         });
         &table[(v - 1) * TABLE_EMAX + (e - 1)]

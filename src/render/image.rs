@@ -19,8 +19,10 @@ pub struct ImageStats {
     pub misses: u64,
     /// Rays that ran out of steps (counted in `misses`).
     pub exhausted: u64,
-    /// Field evaluations over all rays.
+    /// Field evaluations at the scene's beta over all rays.
     pub evals: u64,
+    /// Coarse (far-from-surface) evaluations over all rays.
+    pub coarse_evals: u64,
     /// Field evaluations over the rays that hit.
     pub hit_evals: u64,
     pub max_evals_per_ray: u32,
@@ -44,8 +46,13 @@ impl ImageStats {
     pub fn evals_per_hit(&self) -> f64 {
         self.hit_evals as f64 / self.hits.max(1) as f64
     }
+    /// Leaves per evaluation, coarse and fine together.
     pub fn leaves_per_eval(&self) -> f64 {
-        self.leaves as f64 / self.evals.max(1) as f64
+        self.leaves as f64 / (self.evals + self.coarse_evals).max(1) as f64
+    }
+    /// Leaves visited per ray: the total work.
+    pub fn leaves_per_ray(&self) -> f64 {
+        self.leaves as f64 / self.rays.max(1) as f64
     }
     pub fn rays_per_second(&self) -> f64 {
         self.rays as f64 / self.seconds.max(1e-12)
@@ -111,7 +118,8 @@ pub fn render(
         for (px, r) in row.iter().enumerate() {
             let st = &r.stats;
             stats.evals += st.evals as u64;
-            stats.max_evals_per_ray = stats.max_evals_per_ray.max(st.evals);
+            stats.coarse_evals += st.coarse_evals as u64;
+            stats.max_evals_per_ray = stats.max_evals_per_ray.max(st.evals + st.coarse_evals);
             stats.leaves += st.eval.leaves() as u64;
             stats.nodes += st.eval.nodes as u64;
             stats.falloffs += st.falloffs as u64;

@@ -5,4 +5,5 @@ pub mod tracer;
 
 pub use object::TraceObject;
 pub use tracer::{Hit, RayResult, RayStats, Tracer, TracerOptions};
+pub mod build;
 pub mod image;

@@ -52,11 +52,22 @@ impl TraceObject {
         r - reach
     }
 
-    /// Evaluates the smooth distance with the object's parameters (alpha possibly
-    /// replaced, for the naive mode's falloff), with the gradient if `grad`.
-    pub fn evaluate(&self, sets: &[&AnySet], x: DVec3, alpha: f64, grad: bool) -> Sample {
+    /// Evaluates the smooth distance with the object's parameters, alpha possibly
+    /// replaced (the naive mode's falloff) and beta possibly coarsened (a coarser
+    /// Barnes-Hut sum is a lower bound of a finer one), with the gradient if `grad`.
+    pub fn evaluate(
+        &self,
+        sets: &[&AnySet],
+        x: DVec3,
+        alpha: f64,
+        beta: Option<f64>,
+        grad: bool,
+    ) -> Sample {
         let mut p = self.params;
         p.alpha = alpha;
+        if let Some(b) = beta {
+            p.beta = b.max(p.beta);
+        }
         if grad {
             eval::evaluate(sets, x, &p)
         } else {

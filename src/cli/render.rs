@@ -1,0 +1,253 @@
+//! `smoothtrace render`: a scene file to a PNG, with a progress bar, a one-line summary,
+//! and optional statistics (JSON) and depth (EXR) outputs.
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use smoothtrace::render::build::{BuiltScene, build_scene};
+use smoothtrace::render::image::{ImageStats, Rendered, render};
+use smoothtrace::render::{Tracer, TracerOptions};
+use smoothtrace::scene::{AlphaSpec, Evaluation, Scene};
+use std::path::{Path, PathBuf};
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Scene file (TOML; see the README for the format).
+    scene: PathBuf,
+    /// Output image (PNG).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Override the image width.
+    #[arg(long)]
+    width: Option<i64>,
+    /// Override the image height.
+    #[arg(long)]
+    height: Option<i64>,
+    /// Override the Barnes-Hut parameter (0 = exact sum).
+    #[arg(long)]
+    beta: Option<f64>,
+    /// Override every object's alpha (absolute, 1/length).
+    #[arg(long, conflicts_with = "alpha_rel")]
+    alpha: Option<f64>,
+    /// Override every object's alpha relative to its bounding-box diagonal.
+    #[arg(long)]
+    alpha_rel: Option<f64>,
+    /// Use the naive (unshifted) sum with alpha falloff, as the paper did.
+    #[arg(long)]
+    naive: bool,
+    /// Worker threads (0 = all cores).
+    #[arg(long)]
+    threads: Option<i64>,
+    /// Write the render statistics as JSON.
+    #[arg(long)]
+    stats: Option<PathBuf>,
+    /// Write the hit distance along each ray as an EXR (RGB all equal; misses +inf).
+    #[arg(long)]
+    depth: Option<PathBuf>,
+    /// Opening parameter of the cheap steps taken far from the surface (0 = off: every
+    /// step at the scene's beta).
+    #[arg(long, default_value_t = 4.0)]
+    coarse_beta: f64,
+    /// List what was built (meshes, primitive sets, BVHs, MatCaps) and its times.
+    #[arg(short, long)]
+    verbose: bool,
+}
+
+/// Loads the scene and applies the command-line overrides, then validates again.
+pub fn load_scene(
+    path: &Path,
+    width: Option<i64>,
+    height: Option<i64>,
+    beta: Option<f64>,
+    alpha: Option<AlphaSpec>,
+    threads: Option<i64>,
+) -> Result<Scene> {
+    let mut scene = Scene::load(path)?;
+    let size = |name: &str, v: i64| -> Result<u32> {
+        if !(1..=smoothtrace::scene::MAX_IMAGE_SIZE as i64).contains(&v) {
+            bail!(
+                "--{name} must be in 1..={} (got {v})",
+                smoothtrace::scene::MAX_IMAGE_SIZE
+            );
+        }
+        Ok(v as u32)
+    };
+    if let Some(w) = width {
+        scene.image.width = size("width", w)?;
+    }
+    if let Some(h) = height {
+        scene.image.height = size("height", h)?;
+    }
+    if let Some(b) = beta {
+        if !(0.0..=1.0).contains(&b) {
+            bail!("--beta must be in [0, 1] (got {b})");
+        }
+        scene.render.beta = b;
+    }
+    if let Some(a) = alpha {
+        if !(a.value() > 0.0 && a.value().is_finite()) {
+            bail!(
+                "--{} must be a positive number (got {})",
+                a.key().replace('_', "-"),
+                a.value()
+            );
+        }
+        for o in &mut scene.objects {
+            o.alpha = a;
+        }
+    }
+    if let Some(t) = threads {
+        if !(0..=1024).contains(&t) {
+            bail!("--threads must be in 0..=1024 (got {t})");
+        }
+        scene.render.threads = t as usize;
+    }
+    scene.validate()?;
+    Ok(scene)
+}
+
+/// A progress bar over image rows on standard error (hidden when it is not a terminal).
+pub fn row_progress(rows: u64, label: &str) -> ProgressBar {
+    let bar = ProgressBar::new(rows);
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, {elapsed} (eta {eta})")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_message(label.to_string());
+    bar
+}
+
+/// Builds and renders a loaded scene in a pool of `scene.render.threads` threads.
+pub fn render_scene(
+    scene: &Scene,
+    label: &str,
+    coarse_beta: f64,
+) -> Result<(BuiltScene, Rendered)> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(scene.render.threads)
+        .build()
+        .context("cannot start the worker threads")?;
+    pool.install(|| {
+        let built = build_scene(scene)?;
+        let tracer = Tracer::new(
+            &built.objects,
+            TracerOptions {
+                coarse_beta,
+                ..TracerOptions::new(built.epsilon, scene.render.max_steps)
+            },
+        );
+        let bar = row_progress(scene.image.height as u64, label);
+        let rendered = render(
+            &tracer,
+            &built.camera,
+            &built.shaders,
+            scene.image.background,
+            &|n| bar.set_position(n),
+        );
+        bar.finish_and_clear();
+        Ok((built, rendered))
+    })
+}
+
+pub fn run(a: RenderArgs) -> Result<()> {
+    let alpha = match (a.alpha, a.alpha_rel) {
+        (Some(v), _) => Some(AlphaSpec::Absolute(v)),
+        (None, Some(v)) => Some(AlphaSpec::Relative(v)),
+        _ => None,
+    };
+    let mut scene = load_scene(&a.scene, a.width, a.height, a.beta, alpha, a.threads)?;
+    if a.naive {
+        scene.render.evaluation = Evaluation::Naive;
+    }
+    if !(a.coarse_beta >= 0.0 && a.coarse_beta.is_finite()) {
+        bail!("--coarse-beta must be >= 0 (got {})", a.coarse_beta);
+    }
+    let (built, rendered) = render_scene(&scene, &a.scene.display().to_string(), a.coarse_beta)?;
+    if a.verbose {
+        for s in &built.steps {
+            eprintln!("object[{}] {} ({:.3} s)", s.object, s.what, s.seconds);
+        }
+        eprintln!(
+            "epsilon {} (scene diagonal {})",
+            built.epsilon,
+            built.bounds.diagonal()
+        );
+    }
+    let st = &rendered.stats;
+    if st.camera_inside {
+        bail!(
+            "{}: the camera at {} is inside the surface (the smooth distance there is <= 0): move it out, or raise alpha",
+            a.scene.display(),
+            scene.camera.origin
+        );
+    }
+    rendered
+        .image
+        .save(&a.output)
+        .with_context(|| format!("cannot write {}", a.output.display()))?;
+    if let Some(p) = &a.stats {
+        write_stats_json(p, &a.scene, st, &built)?;
+    }
+    if let Some(p) = &a.depth {
+        write_depth_exr(p, &rendered)?;
+    }
+    eprintln!("{}", summary(&a.scene, st, &a.output));
+    if st.exhausted > 0 {
+        eprintln!(
+            "warning: {} rays ran out of steps (max_steps = {}) and were drawn as misses",
+            st.exhausted, scene.render.max_steps
+        );
+    }
+    if st.falloffs > 0 {
+        eprintln!(
+            "note: alpha falloff fired {} times (the naive sum underflowed)",
+            st.falloffs
+        );
+    }
+    Ok(())
+}
+
+/// The one-line summary printed after a render.
+pub fn summary(scene: &Path, st: &ImageStats, output: &Path) -> String {
+    format!(
+        "{}: {}x{} in {:.3} s on {} threads ({:.0} rays/s), {:.2} evaluations/ray ({:.2} per hit ray, max {}) + {:.2} coarse, {:.1} leaves/evaluation, {:.0} leaves/ray, {:.1}% hits -> {}",
+        scene.display(),
+        st.width,
+        st.height,
+        st.seconds,
+        st.threads,
+        st.rays_per_second(),
+        st.evals_per_ray(),
+        st.evals_per_hit(),
+        st.max_evals_per_ray,
+        st.coarse_evals as f64 / st.rays.max(1) as f64,
+        st.leaves_per_eval(),
+        st.leaves_per_ray(),
+        100.0 * st.hits as f64 / st.rays.max(1) as f64,
+        output.display()
+    )
+}
+
+fn write_stats_json(path: &Path, scene: &Path, st: &ImageStats, built: &BuiltScene) -> Result<()> {
+    let json = serde_json::json!({
+        "scene": scene.display().to_string(),
+        "image": st,
+        "evals_per_ray": st.evals_per_ray(),
+        "evals_per_hit_ray": st.evals_per_hit(),
+        "leaves_per_eval": st.leaves_per_eval(),
+        "rays_per_second": st.rays_per_second(),
+        "epsilon": built.epsilon,
+        "build": built.steps,
+    });
+    std::fs::write(path, serde_json::to_string_pretty(&json)?)
+        .with_context(|| format!("cannot write {}", path.display()))
+}
+
+fn write_depth_exr(path: &Path, r: &Rendered) -> Result<()> {
+    let (w, h) = (r.image.width(), r.image.height());
+    let data: Vec<f32> = r.depth.iter().flat_map(|&d| [d, d, d]).collect();
+    let img = image::Rgb32FImage::from_raw(w, h, data).context("depth buffer size")?;
+    img.save(path)
+        .with_context(|| format!("cannot write {}", path.display()))
+}

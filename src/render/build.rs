@@ -1,0 +1,214 @@
+//! From a validated [`Scene`] to what the tracer needs: each object's mesh (loaded or
+//! generated, then transformed), the primitive sets it names and nothing else, its
+//! resolved alpha and max_alpha, and its MatCap. Every step is logged with its time so
+//! `--verbose` can show what was built.
+
+use super::object::TraceObject;
+use crate::camera::{Camera, CameraError};
+use crate::eval::{Accumulation, EvalParams};
+use crate::matcap::{MatCap, MatCapError};
+use crate::mesh::{Aabb, Mesh, MeshError};
+use crate::primitives::{AnySet, PrimitiveError};
+use crate::procedural::GeneratorError;
+use crate::scene::{Evaluation, Geometry, Scene};
+use std::time::Instant;
+
+/// Why a scene could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum BuildError {
+    #[error("{scene}: object[{object}]: {source}")]
+    Mesh {
+        scene: String,
+        object: usize,
+        #[source]
+        source: MeshError,
+    },
+    #[error("{scene}: object[{object}]: {source}")]
+    Generator {
+        scene: String,
+        object: usize,
+        #[source]
+        source: GeneratorError,
+    },
+    #[error("{scene}: object[{object}]: {source}")]
+    Primitives {
+        scene: String,
+        object: usize,
+        #[source]
+        source: PrimitiveError,
+    },
+    #[error("{scene}: object[{object}]: {message}")]
+    Invalid {
+        scene: String,
+        object: usize,
+        message: String,
+    },
+    #[error("{scene}: object[{object}].matcap: {source}")]
+    MatCap {
+        scene: String,
+        object: usize,
+        #[source]
+        source: MatCapError,
+    },
+    #[error("{scene}: camera: {source}")]
+    Camera {
+        scene: String,
+        #[source]
+        source: CameraError,
+    },
+}
+
+/// One step of the build, for `--verbose`.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BuildStep {
+    pub object: usize,
+    pub what: String,
+    pub seconds: f64,
+}
+
+/// A scene ready to render.
+pub struct BuiltScene {
+    pub objects: Vec<TraceObject>,
+    /// One shader per object.
+    pub shaders: Vec<MatCap>,
+    pub camera: Camera,
+    /// Hit threshold in world units.
+    pub epsilon: f64,
+    /// Union of the objects' bounding boxes.
+    pub bounds: Aabb,
+    pub steps: Vec<BuildStep>,
+}
+
+/// Builds every object of `scene`.
+pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
+    let name = scene.path.display().to_string();
+    let mut steps = Vec::new();
+    let mut objects = Vec::new();
+    let mut shaders: Vec<MatCap> = Vec::new();
+    let mut loaded_matcaps: Vec<(crate::matcap::MatCapSpec, MatCap)> = Vec::new();
+    for (k, obj) in scene.objects.iter().enumerate() {
+        let t = Instant::now();
+        let mut mesh = match &obj.geometry {
+            Geometry::Mesh(path) => Mesh::load(path).map_err(|source| BuildError::Mesh {
+                scene: name.clone(),
+                object: k,
+                source,
+            })?,
+            Geometry::Generator(g) => g.build().map_err(|source| BuildError::Generator {
+                scene: name.clone(),
+                object: k,
+                source,
+            })?,
+        };
+        if !obj.transform.is_identity() {
+            obj.transform.apply_to_mesh(&mut mesh);
+        }
+        steps.push(BuildStep {
+            object: k,
+            what: format!(
+                "mesh {}: {} vertices, {} segments, {} triangles",
+                mesh.name,
+                mesh.vertices.len(),
+                mesh.segments.len(),
+                mesh.triangles.len()
+            ),
+            seconds: t.elapsed().as_secs_f64(),
+        });
+        let diag = mesh.bounds().diagonal();
+        let invalid = |message: String| BuildError::Invalid {
+            scene: name.clone(),
+            object: k,
+            message,
+        };
+        let alpha = obj.alpha.resolve(diag).ok_or_else(|| {
+            invalid(format!(
+                "{} needs an object with a non-zero bounding box (its diagonal is {diag}); give an absolute alpha",
+                obj.alpha.key()
+            ))
+        })?;
+        let max_alpha = obj.max_alpha_or_alpha().resolve(diag).ok_or_else(|| {
+            invalid(format!(
+                "max_alpha_rel needs a non-zero bounding box (diagonal {diag})"
+            ))
+        })?;
+        if !(alpha > 0.0 && alpha.is_finite() && max_alpha > 0.0 && max_alpha.is_finite()) {
+            return Err(invalid(format!(
+                "alpha ({alpha}) and max_alpha ({max_alpha}) must be positive and finite"
+            )));
+        }
+        let mut sets = Vec::new();
+        for &kind in &obj.primitives {
+            let t = Instant::now();
+            let set = AnySet::build(&mesh, kind).map_err(|source| BuildError::Primitives {
+                scene: name.clone(),
+                object: k,
+                source,
+            })?;
+            let times = set.times();
+            steps.push(BuildStep {
+                object: k,
+                what: format!(
+                    "{kind}: {} primitives, max_adj {}, primitives+valences {:.3} s, BVH {:.3} s ({} nodes)",
+                    set.len(),
+                    set.max_adj(),
+                    times.primitives,
+                    times.bvh,
+                    set.bvh().nodes.len()
+                ),
+                seconds: t.elapsed().as_secs_f64(),
+            });
+            sets.push(set);
+        }
+        drop(mesh);
+        let params = EvalParams {
+            accumulation: match scene.render.evaluation {
+                Evaluation::Stable => Accumulation::Stable,
+                Evaluation::Naive => Accumulation::Naive,
+            },
+            ..EvalParams::new(alpha, max_alpha, scene.render.beta)
+        };
+        steps.push(BuildStep {
+            object: k,
+            what: format!(
+                "parameters: alpha {alpha} (alpha * diagonal {:.4}), max_alpha {max_alpha}, beta {}",
+                alpha * diag,
+                scene.render.beta
+            ),
+            seconds: 0.0,
+        });
+        objects.push(TraceObject::new(sets, params));
+        // Each distinct MatCap is built or loaded once.
+        let shader = match loaded_matcaps.iter().find(|(s, _)| *s == obj.matcap) {
+            Some((_, m)) => m.clone(),
+            None => {
+                let t = Instant::now();
+                let m = MatCap::from_spec(&obj.matcap).map_err(|source| BuildError::MatCap {
+                    scene: name.clone(),
+                    object: k,
+                    source,
+                })?;
+                steps.push(BuildStep {
+                    object: k,
+                    what: format!("matcap {}", obj.matcap),
+                    seconds: t.elapsed().as_secs_f64(),
+                });
+                loaded_matcaps.push((obj.matcap.clone(), m.clone()));
+                m
+            }
+        };
+        shaders.push(shader);
+    }
+    let bounds = objects.iter().fold(Aabb::EMPTY, |b, o| b.union(o.bounds));
+    let camera = scene.camera().map_err(|source| BuildError::Camera {
+        scene: name.clone(),
+        source,
+    })?;
+    Ok(BuiltScene {
+        objects,
+        shaders,
+        camera,
+        epsilon: scene.render.epsilon.resolve(bounds.diagonal()),
+        bounds,
+        steps,
+    })
+}
