@@ -4,6 +4,6 @@ pub mod object;
 pub mod tracer;
 
 pub use object::TraceObject;
-pub use tracer::{Hit, RayResult, RayStats, Tracer, TracerOptions};
+pub use tracer::{Backtrack, Hit, RayResult, RayStats, Tracer, TracerOptions};
 pub mod build;
 pub mod image;

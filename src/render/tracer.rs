@@ -41,6 +41,20 @@ pub struct TracerOptions {
     pub coarse_beta: f64,
     /// Coarse steps are taken while the coarse value exceeds this many epsilons.
     pub coarse_threshold: f64,
+    /// Clip rays to the grown scene box (misses outside it cost no evaluation). Off,
+    /// rays start at the camera's smooth distance and march to the box's far side, as
+    /// in the paper's renderer.
+    pub clip: bool,
+    pub backtrack: Backtrack,
+}
+
+/// How a step that overshoots into the negative band is resolved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backtrack {
+    /// Safeguarded regula falsi on the bracket (default).
+    Illinois,
+    /// March back in steps of epsilon until the value is above -epsilon (the paper's).
+    FixedStep,
 }
 
 impl TracerOptions {
@@ -51,6 +65,20 @@ impl TracerOptions {
             max_steps,
             coarse_beta: 4.0,
             coarse_threshold: 4.0,
+            clip: true,
+            backtrack: Backtrack::Illinois,
+        }
+    }
+
+    /// The paper's tracer: every step at the scene's beta, no ray clipping, fixed-step
+    /// backtracking. (Pair with `EvalParams::prune = false` and the naive sum for the
+    /// paper's evaluator.)
+    pub fn paper(epsilon: f64, max_steps: u32) -> TracerOptions {
+        TracerOptions {
+            coarse_beta: 0.0,
+            clip: false,
+            backtrack: Backtrack::FixedStep,
+            ..TracerOptions::new(epsilon, max_steps)
         }
     }
 }
@@ -205,8 +233,14 @@ impl<'a> Tracer<'a> {
         let eps = self.options.epsilon;
         // The zero set at the object's own alpha lies inside the grown box in both
         // modes (falloff only shortens steps), so the clip holds for the naive sum too.
-        let Some((t_enter, t_max)) = self.clip(o, d) else {
-            return RayResult { hit: None, stats };
+        let (t_enter, t_max) = if self.options.clip {
+            match self.clip(o, d) {
+                Some(range) => range,
+                None => return RayResult { hit: None, stats },
+            }
+        } else {
+            let c = 0.5 * (self.min + self.max);
+            (0.0, (o - c).length() + 0.5 * (self.max - self.min).length())
         };
         let mut t = t_enter.max(t_start);
         let mut prev: Option<(f64, f64)> = None;
@@ -237,6 +271,9 @@ impl<'a> Tracer<'a> {
             }
             if f.s < 0.0 {
                 let hit = match prev {
+                    Some(_) if self.options.backtrack == Backtrack::FixedStep => {
+                        self.step_back(o, d, t, &mut stats)
+                    }
                     Some((tp, sp)) => self.backtrack(o, d, (tp, sp), (t, f.s), &mut stats),
                     // Negative at the first sample: the ray starts inside the band.
                     None => Some(self.hit(o, d, t, &f, &mut stats)),
@@ -257,6 +294,23 @@ impl<'a> Tracer<'a> {
             normal: self.gradient(f.object, point, stats).normalize_or_zero(),
             object: f.object,
         }
+    }
+
+    /// The paper's backtracking: from `t` (where `s < -epsilon`) march back by epsilon
+    /// until `s >= -epsilon`.
+    fn step_back(&self, o: DVec3, d: DVec3, mut t: f64, stats: &mut RayStats) -> Option<Hit> {
+        let eps = self.options.epsilon;
+        while stats.evals + stats.coarse_evals < self.options.max_steps {
+            t -= eps;
+            let before = stats.evals;
+            let f = self.sample(o + t * d, stats, None);
+            stats.backtracks += stats.evals - before;
+            if f.s >= -eps {
+                return Some(self.hit(o, d, t, &f, stats));
+            }
+        }
+        stats.exhausted = true;
+        None
     }
 
     /// Finds the crossing in `[lo, hi]` (`s(lo) > 0 > s(hi)`) by the Illinois method.
