@@ -721,12 +721,11 @@ fn validate_after_overrides() {
     assert_eq!(s.path, PathBuf::new());
 }
 
-/// Every TOML example in the format reference parses and validates.
+/// Every TOML example in the README (the scene format reference) parses and validates.
 #[test]
 fn documented_examples_parse() {
     let doc =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("doc/scene-format.md"))
-            .unwrap();
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir_all(dir.path().join("scenes")).unwrap();
     std::fs::create_dir_all(dir.path().join("data")).unwrap();
@@ -736,9 +735,12 @@ fn documented_examples_parse() {
         let text = block.split("```").next().unwrap();
         let path = dir.path().join(format!("scenes/example{count}.toml"));
         if let Err(e) = Scene::from_str(text, &path) {
-            panic!("example {count} of doc/scene-format.md: {e}\n{text}");
+            panic!("example {count} of README.md: {e}\n{text}");
         }
         count += 1;
     }
-    assert_eq!(count, 2, "expected the complete and the minimal example");
+    assert!(
+        count >= 2,
+        "expected at least the complete and the minimal example"
+    );
 }

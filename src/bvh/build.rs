@@ -1,11 +1,15 @@
-//! Binned surface-area-heuristic build (Wald 2007), parallel with rayon above a size
-//! threshold. Degenerate inputs (all centroids equal, e.g. duplicate points) fall back
-//! to splitting at the middle index, so the build always terminates with leaves of at
-//! most `leaf_size` primitives.
+//! Binned surface-area-heuristic build (Wald 2007), parallel with rayon. Each level makes
+//! one pass over its primitives: the binning pass also gathers, per bin, the primitive
+//! bounds and the centroid bounds, from which both children's boxes follow, so no extra
+//! bounds passes are needed. Large ranges bin in parallel and build their halves in
+//! parallel. Degenerate inputs (all centroids equal, e.g. duplicate points) fall back to
+//! splitting at the middle index, so the build always ends with leaves of at most
+//! `leaf_size` primitives.
 
 use super::{Bvh, Node};
 use crate::mesh::Aabb;
 use glam::Vec3;
+use rayon::prelude::*;
 
 /// Build parameters.
 #[derive(Clone, Copy, Debug)]
@@ -23,11 +27,20 @@ impl Default for BuildOptions {
 const BINS: usize = 16;
 /// Ranges larger than this build their two halves in parallel.
 const PARALLEL_MIN: usize = 16 * 1024;
+/// Ranges larger than this are binned in parallel chunks.
+const PARALLEL_BINNING_MIN: usize = 256 * 1024;
 
 struct Input<'a> {
     bounds: &'a [Aabb],
     centroids: &'a [Vec3],
     leaf_size: usize,
+}
+
+/// Bounds of a range: of its primitives and of their centroids.
+#[derive(Clone, Copy)]
+struct RangeBounds {
+    prims: Aabb,
+    centroids: Aabb,
 }
 
 /// Builds a BVH over primitives given their bounds and centroids.
@@ -42,29 +55,49 @@ pub fn build(bounds: &[Aabb], centroids: &[Vec3], options: BuildOptions) -> Bvh 
         leaf_size: options.leaf_size.max(1),
     };
     let mut order: Vec<u32> = (0..bounds.len() as u32).collect();
-    let nodes = build_range(&input, &mut order, 0);
+    let rb = bounds
+        .par_iter()
+        .zip(centroids.par_iter())
+        .fold(
+            || RangeBounds {
+                prims: Aabb::EMPTY,
+                centroids: Aabb::EMPTY,
+            },
+            |acc, (b, &c)| RangeBounds {
+                prims: acc.prims.union(*b),
+                centroids: acc.centroids.grow(c),
+            },
+        )
+        .reduce(
+            || RangeBounds {
+                prims: Aabb::EMPTY,
+                centroids: Aabb::EMPTY,
+            },
+            |a, b| RangeBounds {
+                prims: a.prims.union(b.prims),
+                centroids: a.centroids.union(b.centroids),
+            },
+        );
+    let nodes = build_range(&input, &mut order, 0, rb);
     Bvh { nodes, order }
 }
 
 /// Builds the subtree over `items` (which start at `offset` in the final order) into a
 /// fresh vector whose child indices are relative to its start.
-fn build_range(input: &Input, items: &mut [u32], offset: usize) -> Vec<Node> {
+fn build_range(input: &Input, items: &mut [u32], offset: usize, rb: RangeBounds) -> Vec<Node> {
     if items.len() < PARALLEL_MIN {
         let mut nodes = Vec::with_capacity(2 * items.len() / input.leaf_size + 1);
-        build_serial(input, items, offset, &mut nodes);
+        build_serial(input, items, offset, rb, &mut nodes);
         return nodes;
     }
-    let (node, mid) = split(input, items);
+    let (mid, left_rb, right_rb) = split(input, items, rb);
     let (left_items, right_items) = items.split_at_mut(mid);
     let (left, right) = rayon::join(
-        || build_range(input, left_items, offset),
-        || build_range(input, right_items, offset + mid),
+        || build_range(input, left_items, offset, left_rb),
+        || build_range(input, right_items, offset + mid, right_rb),
     );
     let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
-    nodes.push(Node {
-        index: (1 + left.len()) as u32,
-        ..node
-    });
+    nodes.push(make_node(rb.prims, (1 + left.len()) as u32, 0, items.len()));
     append_shifted(&mut nodes, left);
     append_shifted(&mut nodes, right);
     nodes
@@ -81,19 +114,29 @@ fn append_shifted(nodes: &mut Vec<Node>, sub: Vec<Node>) {
     }));
 }
 
-fn build_serial(input: &Input, items: &mut [u32], offset: usize, nodes: &mut Vec<Node>) {
-    let here = nodes.len();
+fn build_serial(
+    input: &Input,
+    items: &mut [u32],
+    offset: usize,
+    rb: RangeBounds,
+    nodes: &mut Vec<Node>,
+) {
     if items.len() <= input.leaf_size {
-        let b = range_bounds(input, items);
-        nodes.push(make_node(b, offset as u32, items.len() as u32, items.len()));
+        nodes.push(make_node(
+            rb.prims,
+            offset as u32,
+            items.len() as u32,
+            items.len(),
+        ));
         return;
     }
-    let (node, mid) = split(input, items);
-    nodes.push(node);
+    let here = nodes.len();
+    nodes.push(make_node(rb.prims, 0, 0, items.len()));
+    let (mid, left_rb, right_rb) = split(input, items, rb);
     let (left, right) = items.split_at_mut(mid);
-    build_serial(input, left, offset, nodes);
+    build_serial(input, left, offset, left_rb, nodes);
     nodes[here].index = nodes.len() as u32;
-    build_serial(input, right, offset + mid, nodes);
+    build_serial(input, right, offset + mid, right_rb, nodes);
 }
 
 fn make_node(b: Aabb, index: u32, count: u32, size: usize) -> Node {
@@ -107,12 +150,6 @@ fn make_node(b: Aabb, index: u32, count: u32, size: usize) -> Node {
     }
 }
 
-fn range_bounds(input: &Input, items: &[u32]) -> Aabb {
-    items
-        .iter()
-        .fold(Aabb::EMPTY, |b, &i| b.union(input.bounds[i as usize]))
-}
-
 fn half_area(b: &Aabb) -> f32 {
     if b.is_empty() {
         return 0.0;
@@ -121,15 +158,36 @@ fn half_area(b: &Aabb) -> f32 {
     e.x * e.y + e.y * e.z + e.z * e.x
 }
 
-/// Partitions `items` into two non-empty halves and returns the inner node (its
-/// right-child index to be filled in) and the split position.
-fn split(input: &Input, items: &mut [u32]) -> (Node, usize) {
-    let b = range_bounds(input, items);
-    let node = make_node(b, 0, 0, items.len());
-    let cb = items
-        .iter()
-        .fold(Aabb::EMPTY, |b, &i| b.grow(input.centroids[i as usize]));
-    let ext = cb.extent();
+/// Per-bin counts, primitive bounds and centroid bounds.
+#[derive(Clone, Copy)]
+struct Bins {
+    count: [usize; BINS],
+    prims: [Aabb; BINS],
+    centroids: [Aabb; BINS],
+}
+
+impl Bins {
+    fn new() -> Bins {
+        Bins {
+            count: [0; BINS],
+            prims: [Aabb::EMPTY; BINS],
+            centroids: [Aabb::EMPTY; BINS],
+        }
+    }
+    fn merge(mut self, o: Bins) -> Bins {
+        for k in 0..BINS {
+            self.count[k] += o.count[k];
+            self.prims[k] = self.prims[k].union(o.prims[k]);
+            self.centroids[k] = self.centroids[k].union(o.centroids[k]);
+        }
+        self
+    }
+}
+
+/// Partitions `items` into two non-empty halves; returns the split position and the
+/// bounds of both halves.
+fn split(input: &Input, items: &mut [u32], rb: RangeBounds) -> (usize, RangeBounds, RangeBounds) {
+    let ext = rb.centroids.extent();
     let axis = if ext.x >= ext.y && ext.x >= ext.z {
         0
     } else if ext.y >= ext.z {
@@ -137,36 +195,47 @@ fn split(input: &Input, items: &mut [u32]) -> (Node, usize) {
     } else {
         2
     };
-    let lo = cb.min[axis];
+    let lo = rb.centroids.min[axis];
     let width = ext[axis];
     if !(width > 0.0) {
-        return (node, items.len() / 2);
+        return median_split(input, items, axis);
     }
     let scale = BINS as f32 / width;
     let bin_of = |i: u32| -> usize {
         let c = input.centroids[i as usize][axis];
         (((c - lo) * scale) as usize).min(BINS - 1)
     };
-    let mut counts = [0usize; BINS];
-    let mut boxes = [Aabb::EMPTY; BINS];
-    for &i in items.iter() {
-        let k = bin_of(i);
-        counts[k] += 1;
-        boxes[k] = boxes[k].union(input.bounds[i as usize]);
-    }
-    // Sweep from the right to get suffix areas, then from the left.
+    let bin_all = |chunk: &[u32]| {
+        let mut b = Bins::new();
+        for &i in chunk {
+            let k = bin_of(i);
+            b.count[k] += 1;
+            b.prims[k] = b.prims[k].union(input.bounds[i as usize]);
+            b.centroids[k] = b.centroids[k].grow(input.centroids[i as usize]);
+        }
+        b
+    };
+    let bins = if items.len() >= PARALLEL_BINNING_MIN {
+        items
+            .par_chunks(64 * 1024)
+            .map(bin_all)
+            .reduce(Bins::new, Bins::merge)
+    } else {
+        bin_all(items)
+    };
+    // Suffix costs from the right, then the best split from the left.
     let mut right_cost = [0f32; BINS];
     let (mut acc_b, mut acc_n) = (Aabb::EMPTY, 0usize);
     for k in (1..BINS).rev() {
-        acc_b = acc_b.union(boxes[k]);
-        acc_n += counts[k];
+        acc_b = acc_b.union(bins.prims[k]);
+        acc_n += bins.count[k];
         right_cost[k] = half_area(&acc_b) * acc_n as f32;
     }
     let (mut best, mut best_cost) = (0usize, f32::INFINITY);
     let (mut acc_b, mut acc_n) = (Aabb::EMPTY, 0usize);
     for k in 0..BINS - 1 {
-        acc_b = acc_b.union(boxes[k]);
-        acc_n += counts[k];
+        acc_b = acc_b.union(bins.prims[k]);
+        acc_n += bins.count[k];
         if acc_n == 0 || acc_n == items.len() {
             continue;
         }
@@ -177,28 +246,68 @@ fn split(input: &Input, items: &mut [u32]) -> (Node, usize) {
         }
     }
     if !best_cost.is_finite() {
-        return (node, median_split(input, items, axis));
+        return median_split(input, items, axis);
     }
-    // In-place partition: bins 0..=best to the left.
-    let mut mid = 0;
-    for j in 0..items.len() {
-        if bin_of(items[j]) <= best {
-            items.swap(mid, j);
-            mid += 1;
-        }
-    }
-    if mid == 0 || mid == items.len() {
-        mid = median_split(input, items, axis);
-    }
-    (node, mid)
+    let gather = |range: std::ops::Range<usize>| {
+        range.fold(
+            RangeBounds {
+                prims: Aabb::EMPTY,
+                centroids: Aabb::EMPTY,
+            },
+            |acc, k| RangeBounds {
+                prims: acc.prims.union(bins.prims[k]),
+                centroids: acc.centroids.union(bins.centroids[k]),
+            },
+        )
+    };
+    let mid: usize = bins.count[..=best].iter().sum();
+    partition(items, |i| bin_of(i) <= best);
+    (mid, gather(0..best + 1), gather(best + 1..BINS))
 }
 
-fn median_split(input: &Input, items: &mut [u32], axis: usize) -> usize {
+/// In-place partition: items satisfying `left` first (unstable).
+fn partition(items: &mut [u32], left: impl Fn(u32) -> bool) {
+    let (mut i, mut j) = (0usize, items.len());
+    loop {
+        while i < j && left(items[i]) {
+            i += 1;
+        }
+        while i < j && !left(items[j - 1]) {
+            j -= 1;
+        }
+        if i >= j {
+            break;
+        }
+        items.swap(i, j - 1);
+        i += 1;
+        j -= 1;
+    }
+}
+
+/// Splits at the middle index after ordering by centroid along `axis`; the halves'
+/// bounds are computed directly (this path is rare: coincident centroids).
+fn median_split(
+    input: &Input,
+    items: &mut [u32],
+    axis: usize,
+) -> (usize, RangeBounds, RangeBounds) {
     let mid = items.len() / 2;
     items.select_nth_unstable_by(mid, |&a, &b| {
         let ca = input.centroids[a as usize][axis];
         let cb = input.centroids[b as usize][axis];
         ca.total_cmp(&cb)
     });
-    mid
+    let bounds_of = |s: &[u32]| {
+        s.iter().fold(
+            RangeBounds {
+                prims: Aabb::EMPTY,
+                centroids: Aabb::EMPTY,
+            },
+            |acc, &i| RangeBounds {
+                prims: acc.prims.union(input.bounds[i as usize]),
+                centroids: acc.centroids.grow(input.centroids[i as usize]),
+            },
+        )
+    };
+    (mid, bounds_of(&items[..mid]), bounds_of(&items[mid..]))
 }

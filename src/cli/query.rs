@@ -25,16 +25,16 @@ pub struct QueryArgs {
     )]
     alpha: Option<f64>,
     /// Sharpness relative to the bounding-box diagonal: alpha = ALPHA_REL / diagonal.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     alpha_rel: Option<f64>,
     /// Weight attenuation threshold (default: alpha).
-    #[arg(long, conflicts_with = "max_alpha_rel")]
+    #[arg(long, conflicts_with = "max_alpha_rel", allow_negative_numbers = true)]
     max_alpha: Option<f64>,
     /// max_alpha relative to the diagonal.
     #[arg(long)]
     max_alpha_rel: Option<f64>,
     /// Barnes-Hut opening parameter in [0, 1] (0 = exact sum).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
     beta: f64,
     /// Use the paper's naive (unshifted) accumulation; prints inf where it underflows.
     #[arg(long)]

@@ -4,9 +4,10 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use smoothtrace::render::build::{BuiltScene, build_scene};
-use smoothtrace::render::image::{ImageStats, Rendered, render};
-use smoothtrace::render::{Tracer, TracerOptions};
+use smoothtrace::render::TracerOptions;
+use smoothtrace::render::build::BuiltScene;
+use smoothtrace::render::image::{ImageStats, Rendered};
+use smoothtrace::render::pipeline;
 use smoothtrace::scene::{AlphaSpec, Evaluation, Scene};
 use std::path::{Path, PathBuf};
 
@@ -18,25 +19,25 @@ pub struct RenderArgs {
     #[arg(short, long)]
     output: PathBuf,
     /// Override the image width.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     width: Option<i64>,
     /// Override the image height.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     height: Option<i64>,
     /// Override the Barnes-Hut parameter (0 = exact sum).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     beta: Option<f64>,
     /// Override every object's alpha (absolute, 1/length).
-    #[arg(long, conflicts_with = "alpha_rel")]
+    #[arg(long, conflicts_with = "alpha_rel", allow_negative_numbers = true)]
     alpha: Option<f64>,
     /// Override every object's alpha relative to its bounding-box diagonal.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     alpha_rel: Option<f64>,
     /// Use the naive (unshifted) sum with alpha falloff, as the paper did.
     #[arg(long)]
     naive: bool,
     /// Worker threads (0 = all cores).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     threads: Option<i64>,
     /// Write the render statistics as JSON.
     #[arg(long)]
@@ -118,36 +119,18 @@ pub fn row_progress(rows: u64, label: &str) -> ProgressBar {
     bar
 }
 
-/// Builds and renders a loaded scene in a pool of `scene.render.threads` threads.
+/// Builds and renders a loaded scene with a progress bar over its rows.
 pub fn render_scene(
     scene: &Scene,
     label: &str,
     coarse_beta: f64,
 ) -> Result<(BuiltScene, Rendered)> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(scene.render.threads)
-        .build()
-        .context("cannot start the worker threads")?;
-    pool.install(|| {
-        let built = build_scene(scene)?;
-        let tracer = Tracer::new(
-            &built.objects,
-            TracerOptions {
-                coarse_beta,
-                ..TracerOptions::new(built.epsilon, scene.render.max_steps)
-            },
-        );
-        let bar = row_progress(scene.image.height as u64, label);
-        let rendered = render(
-            &tracer,
-            &built.camera,
-            &built.shaders,
-            scene.image.background,
-            &|n| bar.set_position(n),
-        );
-        bar.finish_and_clear();
-        Ok((built, rendered))
-    })
+    let bar = row_progress(scene.image.height as u64, label);
+    let out = pipeline::render_scene(scene, |o| TracerOptions { coarse_beta, ..o }, &|n| {
+        bar.set_position(n)
+    })?;
+    bar.finish_and_clear();
+    Ok(out)
 }
 
 pub fn run(a: RenderArgs) -> Result<()> {

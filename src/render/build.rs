@@ -50,6 +50,8 @@ pub enum BuildError {
         #[source]
         source: MatCapError,
     },
+    #[error("cannot start the worker threads: {0}")]
+    Threads(String),
     #[error("{scene}: camera: {source}")]
     Camera {
         scene: String,

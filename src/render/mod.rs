@@ -7,3 +7,4 @@ pub use object::TraceObject;
 pub use tracer::{Backtrack, Hit, RayResult, RayStats, Tracer, TracerOptions};
 pub mod build;
 pub mod image;
+pub mod pipeline;

@@ -1,6 +1,6 @@
 //! Scene files (TOML): camera, image, render settings and the objects to draw.
 //!
-//! The format is documented in `doc/scene-format.md`. Loading happens in three steps:
+//! The format is documented in the README (section "Scene files"). Loading happens in three steps:
 //! 1. `raw`: serde structs that mirror the file, `deny_unknown_fields` everywhere, with
 //!    spans on the values checked later; toml errors become `path:line:column: message`.
 //! 2. `resolve`: the raw values become a [`Scene`] (paths resolved against the scene
@@ -268,7 +268,7 @@ impl Scene {
         }
     }
 
-    /// Checks every value (see `doc/scene-format.md` for the ranges) and that the mesh
+    /// Checks every value (see the README (section "Scene files") for the ranges) and that the mesh
     /// and MatCap files exist. Values still equal to those read from the file are
     /// reported with their line and column.
     pub fn validate(&self) -> Result<(), SceneError> {

@@ -1,4 +1,4 @@
-//! Range and consistency checks of a resolved [`Scene`]; see `doc/scene-format.md`.
+//! Range and consistency checks of a resolved [`Scene`]; see the README (section "Scene files").
 //!
 //! Messages name the field by its dotted key (`object[2].alpha`). The location is
 //! attached when the field still holds the value read from the file.
