@@ -35,6 +35,14 @@ impl Node {
         self.count > 0
     }
 
+    /// Squared distance from `x` to the box (0 inside), in f64: traversal decisions
+    /// compare squares and take no square root.
+    #[inline]
+    pub fn distance_squared(&self, x: DVec3) -> f64 {
+        let c = x.clamp(self.min.as_dvec3(), self.max.as_dvec3());
+        (x - c).length_squared()
+    }
+
     /// Distance from `x` to the box (0 inside) and the closest box point, in f64.
     #[inline]
     pub fn distance(&self, x: DVec3) -> (f64, DVec3) {

@@ -104,22 +104,16 @@ fn evaluate_impl<const GRAD: bool>(sets: &[&AnySet], x: DVec3, p: &EvalParams) -
     let mut acc = Accumulator::new(p.alpha, p.accumulation);
     let mut stats = EvalStats::default();
     let total: usize = sets.iter().map(|s| s.len()).sum();
-    let mut w_max: f64 = 1.0;
-    let scales: Vec<WeightScale> = sets
-        .iter()
-        .map(|s| {
-            let sc = WeightScale::new(s.max_adj(), p.alpha, p.max_alpha);
-            w_max = w_max.max(sc.max_weight());
-            sc
-        })
-        .collect();
+    let scale = |s: &AnySet| WeightScale::new(s.max_adj(), p.alpha, p.max_alpha);
+    let w_max = sets.iter().map(|s| scale(s).max_weight()).fold(1.0, f64::max);
     let prune_margin = if p.prune {
         (total.max(1) as f64 * w_max / PRUNE_TOLERANCE).ln() / p.alpha
     } else {
         f64::INFINITY
     };
-    for (set, scale) in sets.iter().zip(&scales) {
-        crate::with_set!(set, s => traverse::<_, GRAD>(s, x, p, scale, prune_margin, &mut acc, &mut stats));
+    for set in sets {
+        let sc = scale(set);
+        crate::with_set!(set, s => traverse::<_, GRAD>(s, x, p, &sc, prune_margin, &mut acc, &mut stats));
     }
     let (s, grad, underflow) = acc.finish();
     Sample {
@@ -149,15 +143,18 @@ fn traverse<P: Primitive, const GRAD: bool>(
         return;
     }
     let w_ff = scale.max_weight();
+    let beta2 = p.beta * p.beta;
+    // The stack holds squared box distances; square roots are taken only for far terms.
     let mut stack: [(u32, f64); STACK] = [(0, 0.0); STACK];
     let mut top = 1;
-    stack[0] = (0, nodes[0].distance(x).0);
+    stack[0] = (0, nodes[0].distance_squared(x));
     while top > 0 {
         top -= 1;
-        let (i, r) = stack[top];
+        let (i, r2) = stack[top];
         let node = &nodes[i as usize];
         stats.nodes += 1;
-        if r > acc.m + prune_margin {
+        let reach = acc.m + prune_margin;
+        if r2 > reach * reach {
             stats.pruned += 1;
             continue;
         }
@@ -175,7 +172,9 @@ fn traverse<P: Primitive, const GRAD: bool>(
             stats.exact += node.count;
             continue;
         }
-        if p.beta > 0.0 && (node.diam as f64) < p.beta * r {
+        let diam = node.diam as f64;
+        if p.beta > 0.0 && diam * diam < beta2 * r2 {
+            let r = r2.sqrt();
             if GRAD {
                 let (_, c) = node.distance(x);
                 acc.add(r, node.size as f64 * w_ff, (x - c) / r, DVec3::ZERO);
@@ -186,8 +185,8 @@ fn traverse<P: Primitive, const GRAD: bool>(
             continue;
         }
         let (l, rr) = (i + 1, node.index);
-        let dl = nodes[l as usize].distance(x).0;
-        let dr = nodes[rr as usize].distance(x).0;
+        let dl = nodes[l as usize].distance_squared(x);
+        let dr = nodes[rr as usize].distance_squared(x);
         // Push the farther child first so the nearer one is popped next.
         let (first, second) = if dl <= dr {
             ((rr, dr), (l, dl))
