@@ -58,13 +58,31 @@ pub struct SweepSeries {
     pub points: Vec<(f64, f64, f64, f64)>,
 }
 
-/// One curve of the grid sweep: `(mean leaves, mean microseconds)` per beta, and a sample
-/// of single queries `(leaves, microseconds)`.
+/// One curve of the grid sweep: `(beta, median leaves, median microseconds)` per beta,
+/// and a sample of single queries `(leaves, microseconds)`.
 #[derive(Clone, Debug)]
 pub struct GridSeries {
     pub label: String,
     pub per_beta: Vec<(f64, f64, f64)>,
     pub samples: Vec<(f64, f64)>,
+}
+
+/// Short tick labels: 3 significant digits, scientific notation outside [0.01, 1e4).
+fn tick(v: &f64) -> String {
+    let a = v.abs();
+    if a == 0.0 {
+        "0".into()
+    } else if !(0.01..1e4).contains(&a) {
+        format!("{v:.0e}")
+    } else {
+        let decimals = (2 - a.log10().floor() as i32).clamp(0, 4) as usize;
+        let t = format!("{v:.decimals$}");
+        if t.contains('.') {
+            t.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            t
+        }
+    }
 }
 
 fn range(v: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
@@ -96,7 +114,7 @@ fn err<E: std::fmt::Debug>(path: &Path) -> impl Fn(E) -> PlotError + '_ {
 pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<(), PlotError> {
     register();
     let e = err(path);
-    let (width, height) = (1400u32, 560u32);
+    let (width, height) = (1400u32, 660u32);
     let mut buf = vec![0u8; (width * height * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
@@ -104,7 +122,8 @@ pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<()
         let root = root
             .titled(title, ("sans-serif", 22).into_font())
             .map_err(&e)?;
-        let (left, right) = root.split_horizontally(620);
+        let (plots, legend) = root.split_vertically(height as i32 - 110);
+        let (left, right) = plots.split_horizontally(620);
         let all = || series.iter().flat_map(|s| s.points.iter());
         let (t_lo, t_hi) = range(all().map(|p| p.1), true);
         let mut c = ChartBuilder::on(&left)
@@ -117,6 +136,9 @@ pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<()
             .x_desc("beta")
             .y_desc("render time (s)")
             .label_style(("sans-serif", 14))
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .light_line_style(WHITE)
             .axis_desc_style(("sans-serif", 16))
             .draw()
             .map_err(&e)?;
@@ -136,13 +158,6 @@ pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<()
             )
             .map_err(&e)?;
         }
-        c.configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 15))
-            .draw()
-            .map_err(&e)?;
-
         let (x_lo, x_hi) = range(all().map(|p| p.1), true);
         let (_, y_hi) = range(all().flat_map(|p| [100.0 * p.2, 100.0 * p.3]), false);
         let mut c = ChartBuilder::on(&right)
@@ -155,6 +170,9 @@ pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<()
             .x_desc("render time (s)")
             .y_desc("isosurface error (% of diagonal)")
             .label_style(("sans-serif", 14))
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .light_line_style(WHITE)
             .axis_desc_style(("sans-serif", 16))
             .draw()
             .map_err(&e)?;
@@ -167,15 +185,17 @@ pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<()
             .map_err(&e)?
             .label(format!("{} mean", s.label))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2)));
-            c.draw_series(DashedLineSeries::new(
+            c.draw_series(LineSeries::new(
                 s.points.iter().map(|p| (p.1, 100.0 * p.3)),
-                6,
-                4,
                 col.stroke_width(1),
             ))
-            .map_err(&e)?
-            .label(format!("{} p95", s.label))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(1)));
+            .map_err(&e)?;
+            c.draw_series(
+                s.points
+                    .iter()
+                    .map(|p| Cross::new((p.1, 100.0 * p.3), 4, col.stroke_width(1))),
+            )
+            .map_err(&e)?;
             c.draw_series(s.points.iter().map(|p| {
                 EmptyElement::at((p.1, 100.0 * p.2))
                     + Circle::new((0, 0), 4, col.filled())
@@ -183,12 +203,33 @@ pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<()
             }))
             .map_err(&e)?;
         }
-        c.configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
+        // The legend, in a strip under both panels.
+        let n = series.len().max(1) as i32;
+        let per_row = 3.min(n);
+        for (i, s) in series.iter().enumerate() {
+            let col = COLOURS[i % COLOURS.len()];
+            let (x, y) = (30 + (i as i32 % per_row) * 450, 10 + (i as i32 / per_row) * 24);
+            legend
+                .draw(&PathElement::new(
+                    vec![(x, y + 8), (x + 30, y + 8)],
+                    col.stroke_width(3),
+                ))
+                .map_err(&e)?;
+            legend
+                .draw(&Text::new(
+                    s.label.clone(),
+                    (x + 38, y),
+                    ("sans-serif", 15).into_font(),
+                ))
+                .map_err(&e)?;
+        }
+        let y = 10 + ((n + per_row - 1) / per_row) * 24;
+        legend
+            .draw(&Text::new(
+                "right: thick with dots = mean, thin with crosses = 95th percentile, over the rays that hit in both renders; numbers = beta",
+                (30, y),
+                ("sans-serif", 14).into_font(),
+            ))
             .map_err(&e)?;
         root.present().map_err(&e)?;
     }
@@ -196,7 +237,8 @@ pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<()
 }
 
 /// Time per query against leaves visited (log-log): single queries as faint dots, the
-/// mean per beta as a line with markers labelled by beta.
+/// median per beta (robust to the odd query preempted by another process) as a line
+/// with markers labelled by beta.
 pub fn grid_plot(path: &Path, title: &str, series: &[GridSeries]) -> Result<(), PlotError> {
     register();
     let e = err(path);
@@ -234,6 +276,9 @@ pub fn grid_plot(path: &Path, title: &str, series: &[GridSeries]) -> Result<(), 
             .x_desc("leaves visited per query")
             .y_desc("time per query (microseconds, one thread)")
             .label_style(("sans-serif", 14))
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .light_line_style(WHITE)
             .axis_desc_style(("sans-serif", 16))
             .draw()
             .map_err(&e)?;

@@ -18,7 +18,7 @@
 
 use super::compare::{DepthDiff, compare_depths};
 use super::table::{Cell, Table};
-use super::{Progress, render_objects};
+use super::{Progress, quantile, render_objects};
 use crate::eval::{self, Accumulation, EvalParams};
 use crate::mesh::{Aabb, Mesh};
 use crate::primitives::AnySet;
@@ -358,9 +358,11 @@ pub struct GridRow {
     pub queries: usize,
     /// Wall-clock seconds for all queries (in parallel).
     pub seconds: f64,
-    /// Mean of the per-query times, microseconds (one thread each).
+    /// Mean and median of the per-query times, microseconds (one thread each).
     pub us_per_query: f64,
+    pub us_median: f64,
     pub leaves_mean: f64,
+    pub leaves_median: f64,
     pub leaves_max: u32,
     /// `|s_beta - s_0| / diagonal`: mean and max.
     pub error_mean: f64,
@@ -521,6 +523,13 @@ pub fn run_grid(
                 queries: results.len(),
                 seconds,
                 us_per_query: results.iter().map(|r| r.2).sum::<f64>() / nq,
+                us_median: quantile(&mut results.iter().map(|r| r.2).collect::<Vec<_>>(), 0.5)
+                    .unwrap_or(0.0),
+                leaves_median: quantile(
+                    &mut results.iter().map(|r| r.1 as f64).collect::<Vec<_>>(),
+                    0.5,
+                )
+                .unwrap_or(0.0),
                 leaves_mean: results.iter().map(|r| r.1 as f64).sum::<f64>() / nq,
                 leaves_max: results.iter().map(|r| r.1).max().unwrap_or(0),
                 error_mean: errs.iter().sum::<f64>() / nq,
@@ -548,8 +557,10 @@ pub fn grid_table(rows: &[GridRow]) -> Table {
         ("queries", "queries"),
         ("seconds", "time (s)"),
         ("us_per_query", "us/query"),
+        ("us_median", "median us"),
         ("speedup", "speedup"),
         ("leaves_mean", "leaves"),
+        ("leaves_median", "median leaves"),
         ("leaves_max", "max leaves"),
         ("error_mean", "err mean"),
         ("error_max", "err max"),
@@ -571,8 +582,10 @@ pub fn grid_table(rows: &[GridRow]) -> Table {
             Cell::int(r.queries as i64),
             Cell::num(r.seconds, 3),
             Cell::num(r.us_per_query, 2),
+            Cell::num(r.us_median, 2),
             Cell::num(base, 2),
             Cell::num(r.leaves_mean, 1),
+            Cell::num(r.leaves_median, 0),
             Cell::int(r.leaves_max as i64),
             Cell::sci(r.error_mean),
             Cell::sci(r.error_max),
@@ -639,7 +652,7 @@ pub fn grid_series(rows: &[GridRow]) -> Vec<super::plot::GridSeries> {
                 label: format!("{} ({}, n={})", rs[0].kinds, scene, rs[0].n),
                 per_beta: rs
                     .iter()
-                    .map(|r| (r.beta, r.leaves_mean, r.us_per_query))
+                    .map(|r| (r.beta, r.leaves_median, r.us_median))
                     .collect(),
                 samples: rs
                     .iter()
