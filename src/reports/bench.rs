@@ -130,9 +130,21 @@ pub enum BenchError {
     #[error("unknown Table 1 row '{0}'; the rows are: {rows}", rows = row_names().join(", "))]
     UnknownRow(String),
     #[error(transparent)]
-    Scene(#[from] SceneError),
+    Scene(Box<SceneError>),
     #[error(transparent)]
-    Build(#[from] crate::render::build::BuildError),
+    Build(Box<crate::render::build::BuildError>),
+}
+
+impl From<SceneError> for BenchError {
+    fn from(e: SceneError) -> Self {
+        BenchError::Scene(Box::new(e))
+    }
+}
+
+impl From<crate::render::build::BuildError> for BenchError {
+    fn from(e: crate::render::build::BuildError) -> Self {
+        BenchError::Build(Box::new(e))
+    }
 }
 
 /// The row names, in Table 1 order.

@@ -136,9 +136,9 @@ pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<()
             .x_desc("beta")
             .y_desc("render time (s)")
             .label_style(("sans-serif", 14))
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
-        .light_line_style(WHITE)
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .light_line_style(WHITE)
             .axis_desc_style(("sans-serif", 16))
             .draw()
             .map_err(&e)?;
@@ -170,9 +170,9 @@ pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<()
             .x_desc("render time (s)")
             .y_desc("isosurface error (% of diagonal)")
             .label_style(("sans-serif", 14))
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
-        .light_line_style(WHITE)
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .light_line_style(WHITE)
             .axis_desc_style(("sans-serif", 16))
             .draw()
             .map_err(&e)?;
@@ -208,7 +208,10 @@ pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<()
         let per_row = 3.min(n);
         for (i, s) in series.iter().enumerate() {
             let col = COLOURS[i % COLOURS.len()];
-            let (x, y) = (30 + (i as i32 % per_row) * 450, 10 + (i as i32 / per_row) * 24);
+            let (x, y) = (
+                30 + (i as i32 % per_row) * 450,
+                10 + (i as i32 / per_row) * 24,
+            );
             legend
                 .draw(&PathElement::new(
                     vec![(x, y + 8), (x + 30, y + 8)],
@@ -276,9 +279,9 @@ pub fn grid_plot(path: &Path, title: &str, series: &[GridSeries]) -> Result<(), 
             .x_desc("leaves visited per query")
             .y_desc("time per query (microseconds, one thread)")
             .label_style(("sans-serif", 14))
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
-        .light_line_style(WHITE)
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .light_line_style(WHITE)
             .axis_desc_style(("sans-serif", 16))
             .draw()
             .map_err(&e)?;
@@ -288,12 +291,18 @@ pub fn grid_plot(path: &Path, title: &str, series: &[GridSeries]) -> Result<(), 
                 s.samples
                     .iter()
                     .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-                    .map(|&p| Circle::new(p, 1, col.mix(0.25).filled())),
+                    .map(|&p| Circle::new(p, 1, col.mix(0.15).filled())),
             )
             .map_err(&e)?;
         }
         for (i, s) in series.iter().enumerate() {
             let col = COLOURS[i % COLOURS.len()];
+            // A dark outline keeps the medians visible over the cloud of the same colour.
+            c.draw_series(LineSeries::new(
+                s.per_beta.iter().map(|p| (p.1, p.2)),
+                BLACK.stroke_width(5),
+            ))
+            .map_err(&e)?;
             c.draw_series(LineSeries::new(
                 s.per_beta.iter().map(|p| (p.1, p.2)),
                 col.stroke_width(3),
@@ -303,8 +312,13 @@ pub fn grid_plot(path: &Path, title: &str, series: &[GridSeries]) -> Result<(), 
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(3)));
             c.draw_series(s.per_beta.iter().map(|p| {
                 EmptyElement::at((p.1, p.2))
-                    + Circle::new((0, 0), 5, col.filled())
-                    + Text::new(format!("{}", p.0), (6, -16), ("sans-serif", 12).into_font())
+                    + Circle::new((0, 0), 6, BLACK.filled())
+                    + Circle::new((0, 0), 4, col.filled())
+                    + Text::new(
+                        format!("{}", p.0),
+                        (-24, -6),
+                        ("sans-serif", 12).into_font(),
+                    )
             }))
             .map_err(&e)?;
         }

@@ -634,17 +634,18 @@ fn field_violations(r: &CaseResult, scale_checked: bool) -> Vec<String> {
             r.above_exact
         ));
     }
-    if let Some(d) = r.max_deviation.filter(|&d| !(d <= DEVIATION_TOL)) {
+    if let Some(d) = r.max_deviation.filter(|&d| d.is_nan() || d > DEVIATION_TOL) {
         v.push(format!(
             "deviation {d:.3e} from the brute force (tolerance {DEVIATION_TOL:e})"
         ));
     }
-    if scale_checked {
-        if let Some(d) = r.scale_deviation.filter(|&d| !(d <= SCALE_TOL)) {
-            v.push(format!(
-                "scaled copy deviates {d:.3e} from the unscaled one (tolerance {SCALE_TOL:e})"
-            ));
-        }
+    if let Some(d) = r
+        .scale_deviation
+        .filter(|&d| scale_checked && (d.is_nan() || d > SCALE_TOL))
+    {
+        v.push(format!(
+            "scaled copy deviates {d:.3e} from the unscaled one (tolerance {SCALE_TOL:e})"
+        ));
     }
     v
 }
@@ -727,7 +728,7 @@ fn run_render(
             let (o, d) = camera.ray((i % w) as u32, (i / w) as u32);
             let x = o + d * t as f64;
             let (s, _, _) = brute::smooth_distance(&refs, x, alpha, alpha);
-            !(s.abs() <= 4.0 * eps)
+            s.is_nan() || s.abs() > 4.0 * eps
         })
         .count() as u64;
     let st = &r.stats;

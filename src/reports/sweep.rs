@@ -37,11 +37,23 @@ pub enum SweepError {
     #[error("{0}")]
     Options(String),
     #[error(transparent)]
-    Scene(#[from] SceneError),
+    Scene(Box<SceneError>),
     #[error(transparent)]
-    Build(#[from] BuildError),
+    Build(Box<BuildError>),
     #[error("{scene}: {message}")]
     Geometry { scene: String, message: String },
+}
+
+impl From<SceneError> for SweepError {
+    fn from(e: SceneError) -> Self {
+        SweepError::Scene(Box::new(e))
+    }
+}
+
+impl From<BuildError> for SweepError {
+    fn from(e: BuildError) -> Self {
+        SweepError::Build(Box::new(e))
+    }
 }
 
 /// The default beta list: 0, 0.1, ..., 1.
@@ -122,7 +134,11 @@ pub struct SweepRow {
     pub hits_percent: f64,
 }
 
-fn load(path: &PathBuf, o: &SweepOptions, alpha: Option<AlphaSpec>) -> Result<Scene, SweepError> {
+fn load(
+    path: &std::path::Path,
+    o: &SweepOptions,
+    alpha: Option<AlphaSpec>,
+) -> Result<Scene, SweepError> {
     let mut scene = Scene::load(path)?;
     if let Some(w) = o.width {
         scene.image.width = w;
