@@ -5,7 +5,7 @@
 //! Data flows one way: [`mesh`] (files, [`procedural`] shapes) -> [`primitives`] (sets
 //! with valences and weights) -> [`bvh`] -> [`eval`] (smooth distance, nearest) ->
 //! [`render`] (tracer, image loop, with [`camera`] and [`matcap`]), configured by
-//! [`scene`] files.
+//! [`scene`] files. The [`reports`] (bench, sweep, stability) call the same library.
 
 pub mod bvh;
 pub mod camera;
@@ -16,4 +16,5 @@ pub mod mesh;
 pub mod primitives;
 pub mod procedural;
 pub mod render;
+pub mod reports;
 pub mod scene;

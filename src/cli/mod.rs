@@ -2,8 +2,12 @@
 //! file, resolves and validates its flags into library types, and reports errors with
 //! their cause chain and exit status 2.
 
+mod bench;
+mod progress;
 mod query;
 mod render;
+mod stability;
+mod sweep;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -25,6 +29,12 @@ enum Command {
     Query(query::QueryArgs),
     /// Render a scene file to a PNG image.
     Render(render::RenderArgs),
+    /// Render the paper's Table 1 rows on this machine and print them beside the paper's.
+    Bench(bench::BenchArgs),
+    /// Render time against isosurface error over the Barnes-Hut parameter beta.
+    Sweep(sweep::SweepArgs),
+    /// Run the numerical stability suite with the stable and the naive evaluators.
+    Stability(stability::StabilityArgs),
 }
 
 /// Parses the command line, runs the command, and maps errors to exit status 2.
@@ -33,6 +43,9 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         Command::Query(a) => query::run(a),
         Command::Render(a) => render::run(a),
+        Command::Bench(a) => bench::run(a),
+        Command::Sweep(a) => sweep::run(a),
+        Command::Stability(a) => stability::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
