@@ -197,7 +197,7 @@ fn split(input: &Input, items: &mut [u32], rb: RangeBounds) -> (usize, RangeBoun
     };
     let lo = rb.centroids.min[axis];
     let width = ext[axis];
-    if !(width > 0.0) {
+    if width.is_nan() || width <= 0.0 {
         return median_split(input, items, axis);
     }
     let scale = BINS as f32 / width;

@@ -123,7 +123,7 @@ fn resolve_alpha(name: &str, abs: Option<f64>, rel: Option<f64>, diag: f64) -> R
             if !(r > 0.0 && r.is_finite()) {
                 bail!("--{name}-rel must be a positive number (got {r})");
             }
-            if !(diag > 0.0) {
+            if diag.is_nan() || diag <= 0.0 {
                 bail!("--{name}-rel needs a mesh with a non-zero bounding box; give --{name}");
             }
             r / diag

@@ -93,8 +93,8 @@ pub fn closest_on_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> TriangleCl
     let ab = b - a;
     let ac = c - a;
     let n2 = ab.cross(ac).length_squared();
-    // `>` is false for NaN and for zero-length edges (0 > 0).
-    if !(n2 > DEGENERATE_SIN2 * ab.length_squared() * ac.length_squared()) {
+    // Zero-length edges give 0 <= 0; NaN input is degenerate too.
+    if n2.is_nan() || n2 <= DEGENERATE_SIN2 * ab.length_squared() * ac.length_squared() {
         return closest_on_degenerate_triangle(x, a, b, c);
     }
     let ap = x - a;

@@ -48,7 +48,7 @@ pub enum BuildError {
         scene: String,
         object: usize,
         #[source]
-        source: MatCapError,
+        source: Box<MatCapError>,
     },
     #[error("cannot start the worker threads: {0}")]
     Threads(String),
@@ -187,7 +187,7 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
                 let m = MatCap::from_spec(&obj.matcap).map_err(|source| BuildError::MatCap {
                     scene: name.clone(),
                     object: k,
-                    source,
+                    source: Box::new(source),
                 })?;
                 steps.push(BuildStep {
                     object: k,
