@@ -134,7 +134,18 @@ fn barnes_hut_never_exceeds_exact_and_is_conservative() {
             for &x in &qs {
                 let s0 = eval::evaluate(&[&set], x, &exact).s;
                 let dmin = eval::nearest(&[&set], x).d;
+                let (s_exact, _, _) = brute::smooth_distance(&[&set], x, alpha, alpha);
+                let rounding = 1e-12 * s_scale(s_exact, alpha);
                 assert!(s0 <= dmin * (1.0 + 1e-12), "s {s0} > dmin {dmin}");
+                // Pruning lowers s by at most 2e-10 / alpha and never raises it.
+                assert!(
+                    s0 <= s_exact + rounding,
+                    "beta 0: {s0} above the exact {s_exact}"
+                );
+                assert!(
+                    s0 >= s_exact - 3e-10 / alpha,
+                    "beta 0: {s0} far below {s_exact}"
+                );
                 for beta in [0.1, 0.5, 1.0] {
                     let p = EvalParams::new(alpha, alpha, beta);
                     let sb = eval::evaluate(&[&set], x, &p).s;
@@ -143,10 +154,9 @@ fn barnes_hut_never_exceeds_exact_and_is_conservative() {
                         (sb - sv).abs() <= 1e-12 * s_scale(sb, alpha),
                         "{sb} vs {sv}"
                     );
-                    // Pruning may raise either value by at most 1e-14 / alpha.
                     assert!(
-                        sb <= s0 + 1e-12 / alpha,
-                        "{k} beta {beta}: {sb} > exact {s0} at {x}"
+                        sb <= s_exact + rounding,
+                        "{k} beta {beta}: {sb} > exact {s_exact} at {x}"
                     );
                 }
             }
@@ -164,12 +174,14 @@ fn pruning_off_gives_the_same_values() {
         let a = eval::evaluate(&[&set], x, &p);
         p.prune = false;
         let b = eval::evaluate(&[&set], x, &p);
+        // Pruning drops less than 1e-10 of the sum and covers it from above.
         assert!(
-            (a.s - b.s).abs() <= 1e-12 * s_scale(b.s, 80.0),
-            "{} vs {}",
+            a.s <= b.s + 1e-12 * s_scale(b.s, 80.0),
+            "{} above {}",
             a.s,
             b.s
         );
+        assert!(b.s - a.s <= 3e-10 / 80.0, "{} vs {}", a.s, b.s);
         assert!(a.stats.leaves() <= b.stats.leaves());
         assert_eq!(b.stats.exact as usize, set.len());
     }

@@ -84,6 +84,27 @@ impl Accumulator {
         }
     }
 
+    /// Multiplies the sums by `factor >= 1`: accounts, from above, for terms that were
+    /// skipped as negligible (their total is known to be below a fraction of the sum), so
+    /// that `s` stays a lower bound of the exact value.
+    #[inline]
+    pub fn inflate(&mut self, factor: f64) {
+        self.s *= factor;
+        self.naive_s *= factor;
+    }
+
+    /// A lower bound of `ln S` for the shifted sum `S` (0 before the first term), from
+    /// the binary exponent of `S`: `S >= 2^e`, so `ln S >= e ln 2`. Costs no logarithm.
+    #[inline]
+    pub fn ln_sum_lower_bound(&self) -> f64 {
+        if self.s >= 1.0 {
+            let e = ((self.s.to_bits() >> 52) & 0x7ff) as i64 - 1023;
+            e as f64 * std::f64::consts::LN_2
+        } else {
+            0.0
+        }
+    }
+
     /// `(s, grad s, underflow)` (the gradient is zero if only `add_value` was used). With no term at all, `s = +inf`.
     pub fn finish(&self) -> (f64, DVec3, bool) {
         if self.naive {

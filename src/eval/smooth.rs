@@ -2,12 +2,15 @@
 //!
 //! Nodes are visited near to far (the shifted sum's reference settles on the first
 //! leaves). At a node with box `B` at distance `r` (closest box point `c`):
-//! - prune: if `r > m + ln(N w_max / tol) / alpha`, where `m` is the smallest exact
-//!   distance seen and `N` the total primitive count, every term below it is smaller
-//!   than `tol / N` of the largest term, so the whole subtree changes the sum by less
-//!   than `tol` (relative, `tol = 1e-14`) and is skipped. This is what makes beta = 0
-//!   cheap at large alpha; it never drops the nearest primitive, so `s <= d_min` holds
-//!   exactly. `EvalParams::prune = false` turns it off (the paper's traversal).
+//! - prune: if `r > m + (ln(N w_max / tol) - ln S) / alpha`, where `m` is the smallest
+//!   exact distance seen, `S` the shifted sum so far (a lower bound of `ln S` from its
+//!   binary exponent) and `N` the total primitive count, every term below the node is
+//!   smaller than `tol S / N`, so all pruned subtrees together hold less than `tol = 1e-10`
+//!   of the final sum. They are skipped, and when anything was pruned the sum is
+//!   multiplied by `1 + 2 tol` to cover them from above: `s` stays a lower bound of the
+//!   exact value and within `2e-10 / alpha` of it. The nearest primitive is never pruned,
+//!   so `s <= d_min` holds exactly. This is what makes beta = 0 cheap at large alpha.
+//!   `EvalParams::prune = false` turns it off (the paper's traversal).
 //! - far field: if the node is not a leaf and `diam(B) < beta r`, add one term
 //!   `n w_ff exp(-alpha r)` with direction `(x - c) / r` and `w_ff = max_adj^q`. Every
 //!   primitive below is at least `r` away with weight at most `w_ff`, so the far term
@@ -19,7 +22,7 @@ use crate::primitives::{AnySet, Primitive, PrimitiveSet, WeightScale};
 use glam::DVec3;
 
 /// Relative size of the sum that pruned subtrees may add up to at most.
-pub const PRUNE_TOLERANCE: f64 = 1e-14;
+pub const PRUNE_TOLERANCE: f64 = 1e-10;
 
 /// Parameters of one smooth-distance evaluation.
 #[derive(Clone, Copy, Debug)]
@@ -105,7 +108,10 @@ fn evaluate_impl<const GRAD: bool>(sets: &[&AnySet], x: DVec3, p: &EvalParams) -
     let mut stats = EvalStats::default();
     let total: usize = sets.iter().map(|s| s.len()).sum();
     let scale = |s: &AnySet| WeightScale::new(s.max_adj(), p.alpha, p.max_alpha);
-    let w_max = sets.iter().map(|s| scale(s).max_weight()).fold(1.0, f64::max);
+    let w_max = sets
+        .iter()
+        .map(|s| scale(s).max_weight())
+        .fold(1.0, f64::max);
     let prune_margin = if p.prune {
         (total.max(1) as f64 * w_max / PRUNE_TOLERANCE).ln() / p.alpha
     } else {
@@ -114,6 +120,11 @@ fn evaluate_impl<const GRAD: bool>(sets: &[&AnySet], x: DVec3, p: &EvalParams) -
     for set in sets {
         let sc = scale(set);
         crate::with_set!(set, s => traverse::<_, GRAD>(s, x, p, &sc, prune_margin, &mut acc, &mut stats));
+    }
+    if stats.pruned > 0 {
+        // The pruned subtrees hold less than PRUNE_TOLERANCE of the final sum (see the
+        // module docs): add that bound back so s never exceeds the exact value.
+        acc.inflate(1.0 + 2.0 * PRUNE_TOLERANCE);
     }
     let (s, grad, underflow) = acc.finish();
     Sample {
@@ -144,6 +155,7 @@ fn traverse<P: Primitive, const GRAD: bool>(
     }
     let w_ff = scale.max_weight();
     let beta2 = p.beta * p.beta;
+    let inv_alpha = 1.0 / p.alpha;
     // The stack holds squared box distances; square roots are taken only for far terms.
     let mut stack: [(u32, f64); STACK] = [(0, 0.0); STACK];
     let mut top = 1;
@@ -153,7 +165,7 @@ fn traverse<P: Primitive, const GRAD: bool>(
         let (i, r2) = stack[top];
         let node = &nodes[i as usize];
         stats.nodes += 1;
-        let reach = acc.m + prune_margin;
+        let reach = acc.m + (prune_margin - acc.ln_sum_lower_bound() * inv_alpha);
         if r2 > reach * reach {
             stats.pruned += 1;
             continue;
