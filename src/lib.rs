@@ -8,3 +8,4 @@ pub mod primitives;
 pub mod bvh;
 pub mod eval;
 pub mod geometry;
+pub mod field;
