@@ -3,7 +3,8 @@
 //!
 //! ```text
 //! cargo run --release --example field_bench -- [--csv out.csv] [--kinds triangles|all]
-//!     [--band REL] [--repeat N] [--no-loose] [--no-bvh] [--only MODEL]
+//!     [--band REL] [--repeat N] [--no-loose] [--loose-no-cull] [--no-bvh] [--only MODEL]
+//!     [--verbose]
 //! ```
 //! `--band REL` adds runs with a narrow band of REL times the mesh diagonal. Data meshes
 //! come from `data/`; when a file is missing or cannot be read yet, a procedural closed
@@ -136,8 +137,10 @@ struct Args {
     band: Option<f64>,
     repeat: usize,
     loose: bool,
+    loose_nocull: bool,
     bvh: bool,
     only: Option<String>,
+    verbose: bool,
 }
 
 fn parse_args() -> Args {
@@ -147,8 +150,10 @@ fn parse_args() -> Args {
         band: None,
         repeat: 1,
         loose: true,
+        loose_nocull: false,
         bvh: true,
         only: None,
+        verbose: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(s) = it.next() {
@@ -169,7 +174,9 @@ fn parse_args() -> Args {
             "--band" => a.band = it.next().and_then(|v| v.parse().ok()),
             "--repeat" => a.repeat = it.next().and_then(|v| v.parse().ok()).unwrap_or(1).max(1),
             "--no-loose" => a.loose = false,
+            "--loose-no-cull" => a.loose_nocull = true,
             "--no-bvh" => a.bvh = false,
+            "--verbose" => a.verbose = true,
             "--only" => a.only = it.next(),
             other => {
                 eprintln!("unknown argument {other}");
@@ -205,7 +212,7 @@ fn main() {
         let mut f = std::io::BufWriter::new(std::fs::File::create(p).expect("cannot create the CSV file"));
         writeln!(
             f,
-            "paper_model,paper_triangles,paper_gpu_seconds,mesh,kind,nx,ny,nz,voxels,method,band,seconds,setup_seconds,domain_seconds,raster_seconds,domain_share,mvoxels_per_second,sites,evaluations_per_voxel"
+            "paper_model,paper_triangles,paper_gpu_seconds,mesh,kind,nx,ny,nz,voxels,method,band,seconds,setup_seconds,domain_seconds,raster_seconds,domain_share,mvoxels_per_second,sites,evaluations_per_voxel,candidates,polygons"
         )
         .unwrap();
         f
@@ -246,34 +253,56 @@ fn main() {
         );
         for &kind in &args.kinds {
             let mut runs: Vec<(String, Method, FieldOptions)> = Vec::new();
-            let o = |band: Option<f64>, domains| FieldOptions {
+            let o = |band: Option<f64>, domains, cull| FieldOptions {
                 band,
                 domains,
+                cull,
                 memory_limit: None,
             };
-            runs.push(("linfac".into(), Method::Linfac, o(None, Domains::Tight)));
+            runs.push((
+                "linfac".into(),
+                Method::Linfac,
+                o(None, Domains::Tight, true),
+            ));
+            runs.push((
+                "linfac no-cull".into(),
+                Method::Linfac,
+                o(None, Domains::Tight, false),
+            ));
             if args.loose {
                 runs.push((
-                    "linfac-loose".into(),
+                    "linfac loose".into(),
                     Method::Linfac,
-                    o(None, Domains::Loose),
+                    o(None, Domains::Loose, true),
                 ));
+                if args.loose_nocull {
+                    runs.push((
+                        "loose no-cull".into(),
+                        Method::Linfac,
+                        o(None, Domains::Loose, false),
+                    ));
+                }
             }
             if args.bvh {
-                runs.push(("bvh".into(), Method::Bvh, o(None, Domains::Tight)));
+                runs.push(("bvh".into(), Method::Bvh, o(None, Domains::Tight, true)));
             }
             if let Some(rel) = args.band {
                 let b = rel * diag;
                 runs.push((
                     format!("linfac band {rel}"),
                     Method::Linfac,
-                    o(Some(b), Domains::Tight),
+                    o(Some(b), Domains::Tight, true),
+                ));
+                runs.push((
+                    format!("no-cull band {rel}"),
+                    Method::Linfac,
+                    o(Some(b), Domains::Tight, false),
                 ));
                 if args.bvh {
                     runs.push((
                         format!("bvh band {rel}"),
                         Method::Bvh,
-                        o(Some(b), Domains::Tight),
+                        o(Some(b), Domains::Tight, true),
                     ));
                 }
             }
@@ -292,7 +321,7 @@ fn main() {
                     s.sites,
                     s.evaluations_per_voxel()
                 );
-                if std::env::var_os("FIELD_BENCH_DEBUG").is_some() {
+                if args.verbose {
                     println!(
                         "    polygons {} ({:.2} per voxel, {:.1} evaluations per polygon)",
                         s.polygons,
@@ -303,7 +332,7 @@ fn main() {
                 if let Some(f) = csv.as_mut() {
                     writeln!(
                         f,
-                        "{},{},{},{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{:.6},{:.4},{:.4},{},{:.4}",
+                        "{},{},{},{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{:.6},{:.4},{:.4},{},{:.4},{},{}",
                         case.paper_model,
                         case.paper_triangles,
                         case.paper_seconds,
@@ -322,7 +351,9 @@ fn main() {
                         s.domain_share(),
                         s.voxels_per_second * 1e-6,
                         s.sites,
-                        s.evaluations_per_voxel()
+                        s.evaluations_per_voxel(),
+                        s.candidates,
+                        s.polygons
                     )
                     .unwrap();
                 }

@@ -1,6 +1,9 @@
 //! Distance fields (SPEC 9): linfac against the BVH and brute force on every voxel, the
 //! grid convention, sampling, the Lipschitz bound, validation and `.npy` output.
 
+// `!(a <= b)` also fails on NaN, which is what the comparisons want.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 mod common;
 
 use common::{Rng, bumpy_sphere, random_wire};
@@ -23,7 +26,14 @@ fn opts(band: Option<f64>, domains: Domains) -> FieldOptions {
     FieldOptions {
         band,
         domains,
-        memory_limit: None,
+        ..FieldOptions::default()
+    }
+}
+
+fn opts_nocull(band: Option<f64>, domains: Domains) -> FieldOptions {
+    FieldOptions {
+        cull: false,
+        ..opts(band, domains)
     }
 }
 
@@ -305,8 +315,10 @@ fn linfac_matches_on_axis_aligned_geometry() {
         let grid = Grid::new(DVec3::splat(-0.25), DVec3::splat(1.25), [12, 12, 12]).unwrap();
         let bvh = run(&m, kind, &grid, Method::Bvh, &opts(None, Domains::Tight));
         for d in [Domains::Tight, Domains::Loose] {
-            let lf = run(&m, kind, &grid, Method::Linfac, &opts(None, d));
-            assert_same(&lf, &bvh, TOL * 1.7, &format!("cube {kind} {d:?}"));
+            for o in [opts(None, d), opts_nocull(None, d)] {
+                let lf = run(&m, kind, &grid, Method::Linfac, &o);
+                assert_same(&lf, &bvh, TOL * 1.7, &format!("cube {kind} {o:?}"));
+            }
         }
     }
     check(&m, &KINDS, 20, false);
@@ -379,8 +391,13 @@ fn linfac_matches_on_data_meshes() {
         let grid = Grid::around(m.bounds(), res).unwrap();
         for kind in KINDS {
             let bvh = run(&m, kind, &grid, Method::Bvh, &opts(None, Domains::Tight));
-            let lf = run(&m, kind, &grid, Method::Linfac, &opts(None, Domains::Tight));
-            assert_same(&lf, &bvh, TOL * diag, &format!("{name} {kind}"));
+            for o in [
+                opts(None, Domains::Tight),
+                opts_nocull(None, Domains::Tight),
+            ] {
+                let lf = run(&m, kind, &grid, Method::Linfac, &o);
+                assert_same(&lf, &bvh, TOL * diag, &format!("{name} {kind} {o:?}"));
+            }
             let band = 0.05 * diag;
             let bvh_b = run(
                 &m,
@@ -679,4 +696,264 @@ fn npy_round_trip_and_preview() {
         .write_npy(&dir.path().join("missing/dir/x.npy"))
         .unwrap_err();
     assert!(e.to_string().contains("cannot write"), "{e}");
+}
+
+/// The long sweep: every data mesh at 64^3 (or 96^3), every kind, both domain types,
+/// with and without band. Run with `cargo test --release --test field -- --ignored`.
+#[test]
+#[ignore]
+fn linfac_matches_on_all_data_meshes_at_high_resolution() {
+    for (name, res) in [
+        ("bunny-7k.obj", 96),
+        ("teapot.obj", 96),
+        ("cow.obj", 96),
+        ("spot.obj", 64),
+        ("fandisk.obj", 64),
+        ("suzanne.obj", 64),
+        ("bunny.obj", 64),
+    ] {
+        let Some(path) = common::data_file(name) else {
+            return;
+        };
+        let m = match Mesh::load(&path) {
+            Ok(m) => m,
+            Err(e) => {
+                println!("skipping {name}: Mesh::load failed ({e})");
+                continue;
+            }
+        };
+        let diag = m.bounds().diagonal();
+        let grid = Grid::around(m.bounds(), res).unwrap();
+        for kind in [PrimitiveKind::Triangles, PrimitiveKind::Edges] {
+            for band in [None, Some(0.04 * diag)] {
+                let bvh = run(&m, kind, &grid, Method::Bvh, &opts(band, Domains::Tight));
+                for o in [
+                    opts(band, Domains::Tight),
+                    opts_nocull(band, Domains::Tight),
+                    opts(band, Domains::Loose),
+                ] {
+                    let lf = run(&m, kind, &grid, Method::Linfac, &o);
+                    assert_same(&lf, &bvh, TOL * diag, &format!("{name} {kind} {o:?}"));
+                }
+            }
+        }
+        println!("{name}: ok");
+    }
+}
+
+/// Runs the built binary with `args`, returning (status code, stdout, stderr).
+fn smoothtrace(args: &[&str]) -> (i32, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_smoothtrace"))
+        .args(args)
+        .output()
+        .expect("cannot run smoothtrace");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn cli_refuses_bad_flags() {
+    let (code, _, err) = smoothtrace(&["field", "x.obj", "-p", "triangles", "-o", "x.npy"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--res"), "{err}");
+    let (code, _, err) = smoothtrace(&[
+        "field",
+        "x.obj",
+        "-p",
+        "triangles",
+        "--res",
+        "8",
+        "--smooth",
+        "-o",
+        "x.npy",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--alpha"), "{err}");
+    let (code, _, err) = smoothtrace(&[
+        "field",
+        "x.obj",
+        "-p",
+        "triangles",
+        "--res",
+        "8",
+        "--res-xyz",
+        "4",
+        "4",
+        "4",
+        "-o",
+        "x.npy",
+    ]);
+    assert_eq!(code, 2, "{err}");
+}
+
+#[test]
+fn cli_writes_npy_and_preview() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("tet.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 2 0\nv 0 0 3\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    )
+    .unwrap();
+    if let Err(e) = Mesh::load(&obj) {
+        println!("skipping: Mesh::load cannot read OBJ yet ({e})");
+        return;
+    }
+    let npy = dir.path().join("tet.npy");
+    let png = dir.path().join("tet.png");
+    let (code, _, err) = smoothtrace(&[
+        "field",
+        obj.to_str().unwrap(),
+        "-p",
+        "triangles",
+        "--res",
+        "16",
+        "-o",
+        npy.to_str().unwrap(),
+        "--preview",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("bounds") && err.contains("spacing") && err.contains("voxels/s"),
+        "{err}"
+    );
+    let bytes = std::fs::read(&npy).unwrap();
+    let f = npyz::NpyFile::new(&bytes[..]).unwrap();
+    // Longest axis z (extent 3 * 1.2 + ...): 16 voxels; the others rounded up.
+    assert_eq!(f.shape()[0], 16, "{:?}", f.shape());
+    assert!(png.exists());
+    // Bounds, band and the bvh method; a bad band is refused with the library's message.
+    let (code, _, err) = smoothtrace(&[
+        "field",
+        obj.to_str().unwrap(),
+        "-p",
+        "edges",
+        "--res-xyz",
+        "5",
+        "6",
+        "7",
+        "--bounds",
+        "-1",
+        "-1",
+        "-1",
+        "2",
+        "3",
+        "4",
+        "--band",
+        "0.5",
+        "--method",
+        "bvh",
+        "-o",
+        npy.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let bytes = std::fs::read(&npy).unwrap();
+    assert_eq!(npyz::NpyFile::new(&bytes[..]).unwrap().shape(), &[7, 6, 5]);
+    let (code, _, err) = smoothtrace(&[
+        "field",
+        obj.to_str().unwrap(),
+        "-p",
+        "points",
+        "--res",
+        "8",
+        "--band=-1",
+        "-o",
+        npy.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("band must be a positive"), "{err}");
+    let (code, _, err) = smoothtrace(&[
+        "field",
+        obj.to_str().unwrap(),
+        "-p",
+        "points",
+        "--res",
+        "8",
+        "--bounds",
+        "1",
+        "0",
+        "0",
+        "0",
+        "1",
+        "1",
+        "-o",
+        npy.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("inverted along x"), "{err}");
+}
+
+/// A rotated copy of `m` (random rotation) moved by `shift`.
+fn rotated(m: &Mesh, rng: &mut Rng, shift: DVec3) -> Mesh {
+    let axis = rng.unit().as_vec3();
+    let q = glam::Quat::from_axis_angle(axis, (rng.next_f64() * std::f64::consts::TAU) as f32);
+    let mut r = m.clone();
+    r.transform(Vec3::ONE, q, shift.as_vec3());
+    r.name = format!("{} rotated", m.name);
+    r
+}
+
+#[test]
+fn random_sweep_of_meshes_grids_and_rotations() {
+    let mut rng = Rng::new(2024);
+    let bases = [
+        bumpy_sphere(6, 9),
+        fin(),
+        fan(),
+        saddle(),
+        pinched(),
+        degenerate(),
+        cube(),
+    ];
+    for round in 0..60 {
+        let base = &bases[round % bases.len()];
+        let shift = 3.0 * rng.vec();
+        let m = if round % 3 == 2 {
+            soup(&mut rng, 25)
+        } else {
+            rotated(base, &mut rng, shift)
+        };
+        let b = m.bounds();
+        let (c, e) = (b.center().as_dvec3(), b.extent().as_dvec3().max_element());
+        // Random bounds that may cut the mesh, random non-cubic resolutions.
+        let lo = c - e * DVec3::new(
+            0.4 + rng.next_f64(),
+            0.4 + rng.next_f64(),
+            0.4 + rng.next_f64(),
+        );
+        let hi = c + e * DVec3::new(
+            0.4 + rng.next_f64(),
+            0.4 + rng.next_f64(),
+            0.4 + rng.next_f64(),
+        );
+        let res = [
+            6 + (rng.next_f64() * 20.0) as usize,
+            6 + (rng.next_f64() * 20.0) as usize,
+            3 + (rng.next_f64() * 20.0) as usize,
+        ];
+        let grid = Grid::new(lo, hi, res).unwrap();
+        let tol = TOL * b.diagonal();
+        for kind in KINDS {
+            for band in [None, Some(0.1 * e)] {
+                let bvh = run(&m, kind, &grid, Method::Bvh, &opts(band, Domains::Tight));
+                for o in [
+                    opts(band, Domains::Tight),
+                    opts_nocull(band, Domains::Tight),
+                    opts(band, Domains::Loose),
+                ] {
+                    let lf = run(&m, kind, &grid, Method::Linfac, &o);
+                    assert_same(
+                        &lf,
+                        &bvh,
+                        tol,
+                        &format!("round {round} {} {kind} {res:?} {o:?}", m.name),
+                    );
+                }
+            }
+        }
+    }
 }

@@ -2,6 +2,7 @@
 //! file, resolves and validates its flags into library types, and reports errors with
 //! their cause chain and exit status 2.
 
+mod field;
 mod query;
 
 use clap::{Parser, Subcommand};
@@ -22,6 +23,8 @@ struct Cli {
 enum Command {
     /// Evaluate the smooth distance, its gradient and the exact distance at query points.
     Query(query::QueryArgs),
+    /// Compute a distance field on a voxel grid (.npy), exact or smooth.
+    Field(field::FieldArgs),
 }
 
 /// Parses the command line, runs the command, and maps errors to exit status 2.
@@ -29,6 +32,7 @@ pub fn run() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Query(a) => query::run(a),
+        Command::Field(a) => field::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,31 +1,48 @@
 //! Slice-by-slice rasterization with linear factorization (SPEC 9).
 //!
-//! For slice `k` (plane `z = z_k`) a pixel `(i, j)` is the voxel centre
+//! For slice `k` (plane `z = z_k`) pixel `(i, j)` is the voxel centre
 //! `o + (i hx, j hy, 0)` with `o = min + h / 2` at height `z_k`. Every 3D half-space
 //! `n . p <= c` of a site's domain becomes the 2D half-plane
-//! `(n_x hx) i + (n_y hy) j <= c - n . o`, and every row of the site's distance vector
-//! `w . (p - anchor)` the affine function `w . (o - anchor) + (w_x hx) i + (w_y hy) j`.
+//! `(n_x hx) i + (n_y hy) j <= c - n . o`, and every row `w` of the site's distance
+//! vector `w . (p - anchor)` the affine function
+//! `w . (o - anchor) + (w_x hx) i + (w_y hy) j`.
 //!
-//! Per slice (slices in parallel):
-//! 1. domains: for each site whose slice range contains `k`, the half-planes of its
-//!    domain on the slice, clipped against the rectangle of pixel centres
-//!    (Sutherland-Hodgman) to get the rows it covers or to reject it;
-//! 2. rasterization: for each row, the span is the intersection of the half-planes with
-//!    the row (exact scan conversion of a convex polygon, no accumulation across rows);
-//!    along the span the distance-vector components start at their value at the left
-//!    end and are advanced by one constant increment per pixel (the linear
-//!    factorization); per pixel only the squared length `a^2 + b^2 (+ c)` is formed and
-//!    min-ed into an f64 buffer of squared distances;
-//! 3. the slice is written out as `sqrt` in f32 (`+inf` beyond the band).
+//! For a site on a slice:
+//! 1. domain: the half-planes, clipped against the rectangle of pixel centres
+//!    (Sutherland-Hodgman; for a face prism the three corners of its cross-section are
+//!    computed directly) give the polygon's bounding rows and columns, or reject it;
+//! 2. rasterization: on row `j` the span is the intersection of the half-planes with the
+//!    row (each bounds `i` by a line `u0 + du j`: exact scan conversion of a convex
+//!    polygon, no accumulation across rows); along the span the distance-vector
+//!    components start at their value at the span's first pixel and are advanced by a
+//!    constant increment per pixel (the linear factorization); per pixel only the
+//!    squared length `a^2 + b^2 (+ c)` is formed and min-ed into an f64 buffer of
+//!    squared distances. With a band, the row is first cut to the interval where that
+//!    quadratic in `i` is `<= band^2` (so the band is exact, not a bounding polygon).
+//!
+//! Finally each slice is written out as `sqrt` in f32 (`+inf` beyond the band). With f64
+//! accumulation the interpolated components drift by at most `NX` ulps along a span.
 //!
 //! A site's slice range comes from convexity: its domain is convex and contains its
 //! witness point, so the slices meeting it form an interval found by two binary
 //! searches on "the clipped polygon is non-empty" (on the grid box, slightly enlarged).
-//! With the f64 accumulation the interpolated components drift by at most `NX` ulps,
-//! far below the 1e-5 tolerance.
+//!
+//! Culling (optional): each slice is split into tiles, and an upper bound `U` of the
+//! distance over each tile is taken from one exact nearest query at its centre
+//! (`U = d(c) + ` the tile's half diagonal, distance being 1-Lipschitz). A site whose
+//! bounding box is farther than `U` from a tile cannot be the closest feature anywhere
+//! in it, so its polygon is cut to the tiles it can win. This keeps the exact result
+//! (every skipped evaluation is of a site that is not the closest) and removes most
+//! of the overlap of face prisms, edge slabs and vertex regions far from their feature.
+//!
+//! Work is organised in blocks of consecutive slices (in parallel, sized so their
+//! buffers stay in cache) and, within a block, in chunks of sites that are turned into
+//! polygons and rasterized slice by slice.
 
 use super::grid::Grid;
 use super::sites::{SiteKind, Sites};
+use crate::eval::nearest::nearest_within;
+use crate::primitives::AnySet;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -38,13 +55,16 @@ pub(crate) struct LinfacRun {
     pub range_seconds: f64,
     /// Wall seconds of the slice loop.
     pub slice_seconds: f64,
-    /// Thread-summed seconds in domain clipping and in rasterization within the loop.
+    /// Thread-summed seconds in the slice loop: domains (tile bounds, clipping,
+    /// culling) and rasterization (spans, evaluation, output).
     pub domain_cpu: f64,
     pub raster_cpu: f64,
     /// Pixel evaluations (sum of span lengths).
     pub evaluations: u64,
-    /// Site-slice pairs that produced a non-empty polygon.
+    /// Site-slice pairs rasterized.
     pub polygons: u64,
+    /// Site-slice pairs within the sites' slice ranges (domain computations).
+    pub candidates: u64,
 }
 
 /// 2D half-plane `a i + b j <= c` in pixel coordinates, with `inv_a = 1 / a` (0 when
@@ -77,6 +97,16 @@ const FLAT: f64 = 1e-12;
 /// a wider span only costs evaluations).
 const SPAN_SLACK: f64 = 1e-6;
 
+/// Sites are processed in chunks of this many, so that a chunk's data stays in cache
+/// while it is rasterized into every slice of a block.
+const SITE_CHUNK: usize = 256;
+
+/// Slice buffers of one block should fit in about this many bytes (a core's L2).
+const BLOCK_BYTES: usize = 768 << 10;
+
+/// Culling aims at about this many tiles per slice.
+const TILES_PER_SLICE: usize = 128;
+
 /// A site's work on one slice.
 #[derive(Clone, Copy, Debug)]
 struct Job {
@@ -85,11 +115,33 @@ struct Job {
     /// from the left.
     lines: (u32, u32),
     n_left: u32,
+    /// With culling: index in `Scratch::tile_spans` of the allowed column interval of
+    /// tile row `rows.0 / tile` (one entry per tile row of the job).
+    tile_spans: Option<u32>,
     /// Distance-vector components: `a(i, j) = a0 + au i + av j`, likewise `b`; `g` is a
     /// constant added to the squared length.
     a: [f64; 3],
     b: [f64; 3],
     g: f64,
+}
+
+#[derive(Default)]
+struct Scratch {
+    hps: Vec<Hp>,
+    lines: Vec<(f64, f64)>,
+    tile_spans: Vec<(f64, f64)>,
+    jobs: Vec<Job>,
+    poly: Vec<(f64, f64)>,
+    poly2: Vec<(f64, f64)>,
+}
+
+/// Tile layout and the per-tile upper bounds of one block of slices.
+struct Tiles<'a> {
+    set: &'a AnySet,
+    size: usize,
+    /// World x range of the pixel centres of each tile column, y of each tile row.
+    xs: Vec<(f64, f64)>,
+    ys: Vec<(f64, f64)>,
 }
 
 /// The grid in pixel coordinates and the sites' half-spaces converted to it.
@@ -102,10 +154,19 @@ struct Raster<'a> {
     h: DVec3,
     nx: usize,
     ny: usize,
+    tiles: Option<Tiles<'a>>,
+}
+
+/// Upper bounds of the distance per tile for the slices of a block (`u[dk][tile]`, tile
+/// `ty * ntx + tx`), and their maximum per slice.
+#[derive(Default)]
+struct Bounds {
+    u: Vec<f64>,
+    umax: Vec<f64>,
 }
 
 impl<'a> Raster<'a> {
-    fn new(sites: &'a Sites, grid: &'a Grid) -> Raster<'a> {
+    fn new(sites: &'a Sites, grid: &'a Grid, cull: Option<&'a AnySet>) -> Raster<'a> {
         let h = grid.spacing();
         let o = grid.min + 0.5 * h;
         let planes = sites
@@ -122,43 +183,117 @@ impl<'a> Raster<'a> {
                 }
             })
             .collect();
+        let (nx, ny) = (grid.res[0], grid.res[1]);
+        let tiles = cull.map(|set| {
+            let size =
+                (((nx * ny) as f64 / TILES_PER_SLICE as f64).sqrt().round() as usize).clamp(4, 32);
+            let span = |n: usize, o: f64, h: f64| -> Vec<(f64, f64)> {
+                (0..n.div_ceil(size))
+                    .map(|t| {
+                        let (i0, i1) = (t * size, ((t + 1) * size).min(n) - 1);
+                        (o + i0 as f64 * h, o + i1 as f64 * h)
+                    })
+                    .collect()
+            };
+            Tiles {
+                set,
+                size,
+                xs: span(nx, o.x, h.x),
+                ys: span(ny, o.y, h.y),
+            }
+        });
         Raster {
             sites,
             grid,
             planes,
             o,
             h,
-            nx: grid.res[0],
-            ny: grid.res[1],
+            nx,
+            ny,
+            tiles,
         }
     }
 
-    /// Pushes the half-planes of site `idx` at height `z` and narrows `rect` to its band
-    /// box. Returns false when the domain misses the slice.
-    fn site_halfplanes(&self, idx: usize, z: f64, rect: &mut [f64; 4], out: &mut Vec<Hp>) -> bool {
-        let site = &self.sites.sites[idx];
-        if let Some(band) = self.sites.band {
-            let (lo, hi) = site.bounds;
-            let (mut rx, mut ry) = (band, band);
-            if site.kind == SiteKind::Vertex {
-                let dz = z - site.anchor.z;
-                let r2 = band * band - dz * dz;
-                if r2 < 0.0 {
-                    return false;
+    /// Fills `b` with the tile bounds of slices `k0 .. k0 + nk`: an exact nearest query
+    /// at each tile centre (bounded by the previous tile's result moved by the distance
+    /// between the centres), plus the tile's half diagonal, plus slack.
+    #[inline(never)]
+    fn tile_bounds(&self, k0: usize, nk: usize, b: &mut Bounds) {
+        let Some(t) = &self.tiles else { return };
+        let (ntx, nty) = (t.xs.len(), t.ys.len());
+        b.u.clear();
+        b.umax.clear();
+        let eta = self.sites.eta;
+        let band = self.sites.band.unwrap_or(f64::INFINITY);
+        let mut prev: Option<(DVec3, f64)> = None;
+        for dk in 0..nk {
+            let z = self.grid.slice_z(k0 + dk);
+            let mut umax = 0.0f64;
+            let first = b.u.len();
+            b.u.resize(first + ntx * nty, 0.0);
+            for ty in 0..nty {
+                for s in 0..ntx {
+                    // Serpentine order keeps consecutive centres close.
+                    let tx = if ty % 2 == 0 { s } else { ntx - 1 - s };
+                    let (x0, x1) = t.xs[tx];
+                    let (y0, y1) = t.ys[ty];
+                    let c = DVec3::new(0.5 * (x0 + x1), 0.5 * (y0 + y1), z);
+                    let r = 0.5 * ((x1 - x0).hypot(y1 - y0));
+                    let bound = prev.map_or(f64::INFINITY, |(pc, pd)| {
+                        (pd + (c - pc).length()) * (1.0 + 1e-9) + eta
+                    });
+                    let mut q = nearest_within(&[t.set], c, bound);
+                    if q.index == u32::MAX {
+                        q = nearest_within(&[t.set], c, f64::INFINITY);
+                    }
+                    prev = Some((c, q.d));
+                    let u = ((q.d + r) * (1.0 + 1e-9) + eta).min(band);
+                    b.u[first + ty * ntx + tx] = u;
+                    umax = umax.max(u);
                 }
-                rx = r2.sqrt();
-                ry = rx;
-            } else if z < lo.z - band || z > hi.z + band {
-                return false;
             }
-            rect[0] = rect[0].max((lo.x - rx - self.o.x) / self.h.x);
-            rect[2] = rect[2].min((hi.x + rx - self.o.x) / self.h.x);
-            rect[1] = rect[1].max((lo.y - ry - self.o.y) / self.h.y);
-            rect[3] = rect[3].min((hi.y + ry - self.o.y) / self.h.y);
-            if !(rect[0] <= rect[2] && rect[1] <= rect[3]) {
-                return false;
-            }
+            b.umax.push(umax);
         }
+    }
+
+    /// Narrows `rect` to the band box of site `idx` at height `z` (the feature's box
+    /// grown by the band; for a vertex, by the radius of its band disk on the slice).
+    /// Returns false when the band misses the slice.
+    fn band_rect(&self, idx: usize, z: f64, rect: &mut [f64; 4]) -> bool {
+        let Some(band) = self.sites.band else {
+            return true;
+        };
+        let site = &self.sites.sites[idx];
+        let (lo, hi) = site.bounds;
+        let r = if site.kind == SiteKind::Vertex {
+            let dz = z - site.anchor.z;
+            let r2 = band * band - dz * dz;
+            if r2 < 0.0 {
+                return false;
+            }
+            r2.sqrt()
+        } else if z < lo.z - band || z > hi.z + band {
+            return false;
+        } else {
+            band
+        };
+        self.narrow(rect, lo, hi, r)
+    }
+
+    /// Narrows `rect` to the xy box `[lo - r, hi + r]` (world units); false if empty.
+    #[inline]
+    fn narrow(&self, rect: &mut [f64; 4], lo: DVec3, hi: DVec3, r: f64) -> bool {
+        rect[0] = rect[0].max((lo.x - r - self.o.x) / self.h.x);
+        rect[2] = rect[2].min((hi.x + r - self.o.x) / self.h.x);
+        rect[1] = rect[1].max((lo.y - r - self.o.y) / self.h.y);
+        rect[3] = rect[3].min((hi.y + r - self.o.y) / self.h.y);
+        rect[0] <= rect[2] && rect[1] <= rect[3]
+    }
+
+    /// Pushes the half-planes of site `idx` at height `z`. Returns false when one of
+    /// them excludes the whole slice.
+    fn push_halfplanes(&self, idx: usize, z: f64, out: &mut Vec<Hp>) -> bool {
+        let site = &self.sites.sites[idx];
         for p in &self.planes[site.planes.0 as usize..site.planes.1 as usize] {
             let hp = Hp {
                 a: p.a,
@@ -174,14 +309,50 @@ impl<'a> Raster<'a> {
         true
     }
 
+    /// Pixel bounding box of the triangle cut from a face's prism by the plane at
+    /// height `z`, from its corners `p + ((z - p_z) / n_z) n` (`None` when the face is
+    /// nearly vertical, `|n_z| < 1e-6`), and the signed plane distances of the corners.
+    /// The box is widened by 1e-6 pixel; pixels that rounding could still drop lie on
+    /// the prism's side planes, inside the (margin-widened) domains of its edges.
+    #[inline]
+    fn face_bbox(&self, idx: usize, z: f64) -> Option<([f64; 4], [f64; 3])> {
+        let site = &self.sites.sites[idx];
+        let n = site.rows[0];
+        if !(n.z.abs() >= 1e-6) {
+            return None;
+        }
+        let inv = 1.0 / n.z;
+        let mut bb = [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        let mut ts = [0.0; 3];
+        for (c, p) in [site.anchor, site.rows[1], site.rows[2]]
+            .into_iter()
+            .enumerate()
+        {
+            let t = (z - p.z) * inv;
+            ts[c] = t;
+            let u = (p.x + t * n.x - self.o.x) / self.h.x;
+            let v = (p.y + t * n.y - self.o.y) / self.h.y;
+            bb = [bb[0].min(u), bb[1].min(v), bb[2].max(u), bb[3].max(v)];
+        }
+        const W: f64 = 1e-6;
+        Some(([bb[0] - W, bb[1] - W, bb[2] + W, bb[3] + W], ts))
+    }
+
     /// Whether the domain of site `idx` meets slice `k` inside the grid box (enlarged
     /// by half a voxel so the witness is strictly inside).
     fn meets_slice(&self, idx: usize, k: usize, s: &mut Scratch) -> bool {
         let mut rect = [-1.0, -1.0, self.nx as f64, self.ny as f64];
         s.hps.clear();
         let mut hps = std::mem::take(&mut s.hps);
-        let ok = self.site_halfplanes(idx, self.grid.slice_z(k), &mut rect, &mut hps)
-            && clip(rect, &hps, &mut s.poly, &mut s.poly2).is_some();
+        let z = self.grid.slice_z(k);
+        let ok = self.band_rect(idx, z, &mut rect)
+            && self.push_halfplanes(idx, z, &mut hps)
+            && clip_bbox(rect, &hps, &mut s.poly, &mut s.poly2).is_some();
         s.hps = hps;
         ok
     }
@@ -250,44 +421,149 @@ impl<'a> Raster<'a> {
         }
     }
 
-    /// Phase 1 of slice `k`: the jobs (rows, half-planes, coefficients) of the sites
-    /// `first..` (with slice ranges `ranges`) whose domains meet it.
-    fn slice_jobs(&self, k: usize, first: usize, ranges: &[(usize, usize)], s: &mut Scratch) {
+    /// Phase 1 of slice `k` (index `dk` in its block): the jobs of sites `first..`
+    /// (with slice ranges `ranges`) whose domains meet it.
+    #[inline(never)]
+    fn slice_jobs(
+        &self,
+        k: usize,
+        dk: usize,
+        first: usize,
+        ranges: &[(usize, usize)],
+        bounds: &Bounds,
+        s: &mut Scratch,
+    ) {
         let z = self.grid.slice_z(k);
         let full = [0.0, 0.0, (self.nx - 1) as f64, (self.ny - 1) as f64];
         s.jobs.clear();
         s.hps.clear();
         s.lines.clear();
+        s.tile_spans.clear();
         let mut hps = std::mem::take(&mut s.hps);
+        let tile_u = self.tiles.as_ref().map(|t| {
+            let n = t.xs.len() * t.ys.len();
+            (&bounds.u[dk * n..(dk + 1) * n], bounds.umax[dk])
+        });
+        let band = self.sites.band.unwrap_or(f64::INFINITY);
         for (n, &(k0, k1)) in ranges.iter().enumerate() {
             if k < k0 || k > k1 {
                 continue;
             }
             let idx = first + n;
-            let first = hps.len();
+            let site = &self.sites.sites[idx];
+            let (lo, hi) = site.bounds;
+            let gz = (lo.z - z).max(z - hi.z).max(0.0);
             let mut rect = full;
-            if !self.site_halfplanes(idx, z, &mut rect, &mut hps) {
-                hps.truncate(first);
+            // With culling, a site can only win where its box is within the largest
+            // tile bound of the slice.
+            let reach = tile_u.map_or(f64::INFINITY, |(_, umax)| umax);
+            if gz > reach || !self.band_rect(idx, z, &mut rect) {
                 continue;
             }
-            let own = &hps[first..];
-            let vrange = if self.sites.sites[idx].kind == SiteKind::Face {
-                prism_rows(own, &rect).unwrap_or_else(|| clip(rect, own, &mut s.poly, &mut s.poly2))
+            if reach.is_finite()
+                && !self.narrow(&mut rect, lo, hi, (reach * reach - gz * gz).sqrt())
+            {
+                continue;
+            }
+            let face = if site.kind == SiteKind::Face {
+                self.face_bbox(idx, z)
             } else {
-                clip(rect, own, &mut s.poly, &mut s.poly2)
+                None
             };
-            let Some((vmin, vmax)) = vrange else {
-                hps.truncate(first);
+            if let Some((_, ts)) = face {
+                // The face's distance on its polygon is |t|, affine: its minimum is at a
+                // corner unless the polygon crosses the face's plane.
+                let lim = reach.min(band);
+                if ts.iter().all(|&t| t > lim) || ts.iter().all(|&t| t < -lim) {
+                    continue;
+                }
+            }
+            let bbox = match face {
+                Some((bb, _)) => Some(bb),
+                None => {
+                    if !self.push_halfplanes(idx, z, &mut hps) {
+                        hps.clear();
+                        continue;
+                    }
+                    clip_bbox(rect, &hps, &mut s.poly, &mut s.poly2)
+                }
+            };
+            let Some([umin, vmin, umax, vmax]) = bbox else {
+                hps.clear();
                 continue;
             };
-            let mut j0 = fast_ceil(vmin.max(rect[1]).max(0.0));
-            let mut j1 = fast_floor(vmax.min(rect[3]).min((self.ny - 1) as f64));
+            let mut j0 = fast_ceil(vmin.max(rect[1]));
+            let mut j1 = fast_floor(vmax.min(rect[3]));
+            let i0 = fast_ceil(umin.max(rect[0]));
+            let i1 = fast_floor(umax.min(rect[2]));
+            if j0 > j1 || i0 > i1 {
+                hps.clear();
+                continue;
+            }
+            let spans0 = s.tile_spans.len();
+            let mut tile_spans = None;
+            if let (Some(t), Some((u, _))) = (&self.tiles, tile_u) {
+                // Lower bound of the site's distance over a tile: the gap between its box
+                // and the tile's, and for a face the distance to its plane.
+                let (tx0, tx1) = (i0 as usize / t.size, i1 as usize / t.size);
+                let (ty0, ty1) = (j0 as usize / t.size, j1 as usize / t.size);
+                let plane = (site.kind == SiteKind::Face).then(|| {
+                    let n = site.rows[0];
+                    (
+                        n,
+                        n.z * (z - site.anchor.z) - n.x * site.anchor.x - n.y * site.anchor.y,
+                    )
+                });
+                let (mut first_row, mut last_row) = (usize::MAX, 0);
+                for ty in ty0..=ty1 {
+                    let (y0, y1) = t.ys[ty];
+                    let gy = (lo.y - y1).max(y0 - hi.y).max(0.0);
+                    let (mut a, mut b) = (usize::MAX, 0);
+                    for tx in tx0..=tx1 {
+                        let (x0, x1) = t.xs[tx];
+                        let gx = (lo.x - x1).max(x0 - hi.x).max(0.0);
+                        let mut l2 = gx * gx + gy * gy + gz * gz;
+                        if let Some((n, s0)) = plane {
+                            let c = s0 + n.x * 0.5 * (x0 + x1) + n.y * 0.5 * (y0 + y1);
+                            let e = 0.5 * (n.x.abs() * (x1 - x0) + n.y.abs() * (y1 - y0));
+                            let l = (c.abs() - e).max(0.0);
+                            l2 = l2.max(l * l);
+                        }
+                        let ub = u[ty * t.xs.len() + tx];
+                        if l2 <= ub * ub {
+                            a = a.min(tx);
+                            b = tx;
+                        }
+                    }
+                    if a <= b {
+                        s.tile_spans
+                            .push(((a * t.size) as f64, ((b + 1) * t.size - 1) as f64));
+                        first_row = first_row.min(ty);
+                        last_row = ty;
+                    } else {
+                        s.tile_spans.push((1.0, 0.0));
+                    }
+                }
+                if first_row > last_row {
+                    hps.clear();
+                    s.tile_spans.truncate(spans0);
+                    continue;
+                }
+                j0 = j0.max((first_row * t.size) as i64);
+                j1 = j1.min(((last_row + 1) * t.size - 1) as i64);
+                tile_spans = Some((spans0 + (j0 as usize / t.size - ty0)) as u32);
+            }
+            if face.is_some() && !self.push_halfplanes(idx, z, &mut hps) {
+                hps.clear();
+                s.tile_spans.truncate(spans0);
+                continue;
+            }
             // Span ends as lines in j: left bounds `i >= u0 + du j`, then right bounds
             // `i <= u0 + du j`; half-planes that do not depend on `i` narrow the rows.
             let lines0 = s.lines.len();
             let mut n_left = 0u32;
             for pass in 0..2 {
-                for hp in &hps[first..] {
+                for hp in &hps {
                     if hp.inv_a != 0.0 {
                         if (hp.a < 0.0) == (pass == 0) {
                             s.lines.push((hp.c * hp.inv_a, -hp.b * hp.inv_a));
@@ -305,9 +581,16 @@ impl<'a> Raster<'a> {
                     }
                 }
             }
-            hps.truncate(first);
+            hps.clear();
+            // The polygon's columns also bound the spans.
+            s.lines.push((i0 as f64, 0.0));
+            s.lines.push((i1 as f64, 0.0));
+            let nl = s.lines.len();
+            s.lines.swap(lines0 + n_left as usize, nl - 2);
+            n_left += 1;
             if j0 > j1 {
                 s.lines.truncate(lines0);
+                s.tile_spans.truncate(spans0);
                 continue;
             }
             let (a, b, g) = self.job_coefficients(idx, z);
@@ -315,6 +598,7 @@ impl<'a> Raster<'a> {
                 rows: (j0 as usize, j1 as usize),
                 lines: (lines0 as u32, s.lines.len() as u32),
                 n_left,
+                tile_spans,
                 a,
                 b,
                 g,
@@ -325,21 +609,24 @@ impl<'a> Raster<'a> {
 
     /// Phase 2: scan-converts the jobs into the slice's squared-distance buffer;
     /// returns the number of pixel evaluations.
+    #[inline(never)]
     fn slice_raster(&self, s: &Scratch, buf: &mut [f64]) -> u64 {
         let nx = self.nx;
-        let umax = (nx - 1) as f64;
         let band2 = self.sites.band.map(|b| b * b);
+        let tile = self.tiles.as_ref().map_or(1, |t| t.size);
         let mut n_eval = 0u64;
         for job in &s.jobs {
             let lines = &s.lines[job.lines.0 as usize..job.lines.1 as usize];
             let (left, right) = lines.split_at(job.n_left as usize);
             for j in job.rows.0..=job.rows.1 {
                 let jf = j as f64;
-                let mut lo = 0.0f64;
+                let (mut lo, mut hi) = match job.tile_spans {
+                    Some(t0) => s.tile_spans[t0 as usize + (j / tile - job.rows.0 / tile)],
+                    None => (f64::NEG_INFINITY, f64::INFINITY),
+                };
                 for &(u0, du) in left {
                     lo = lo.max(u0 + du * jf);
                 }
-                let mut hi = umax;
                 for &(u0, du) in right {
                     hi = hi.min(u0 + du * jf);
                 }
@@ -393,15 +680,6 @@ impl<'a> Raster<'a> {
     }
 }
 
-#[derive(Default)]
-struct Scratch {
-    hps: Vec<Hp>,
-    lines: Vec<(f64, f64)>,
-    jobs: Vec<Job>,
-    poly: Vec<(f64, f64)>,
-    poly2: Vec<(f64, f64)>,
-}
-
 /// `floor` for finite values of moderate size (no libm call on baseline x86-64).
 #[inline]
 fn fast_floor(x: f64) -> i64 {
@@ -416,44 +694,14 @@ fn fast_ceil(x: f64) -> i64 {
     if (t as f64) < x { t + 1 } else { t }
 }
 
-/// Row range of the triangle cut from a face's prism by the slice: its three corners are
-/// the pairwise intersections of the first three half-planes. `Some(None)` when the
-/// triangle misses the rectangle; `None` when two of the planes are (nearly) parallel
-/// (prism nearly parallel to the slice), and the caller clips instead.
-fn prism_rows(h: &[Hp], rect: &[f64; 4]) -> Option<Option<(f64, f64)>> {
-    let (mut umin, mut umax, mut vmin, mut vmax) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for (p, q) in [(h[0], h[1]), (h[1], h[2]), (h[2], h[0])] {
-        let det = p.a * q.b - q.a * p.b;
-        let scale = (p.a.abs() + p.b.abs()) * (q.a.abs() + q.b.abs());
-        if !(det.abs() > 1e-9 * scale) {
-            return None;
-        }
-        let u = (p.c * q.b - q.c * p.b) / det;
-        let v = (p.a * q.c - q.a * p.c) / det;
-        umin = umin.min(u);
-        umax = umax.max(u);
-        vmin = vmin.min(v);
-        vmax = vmax.max(v);
-    }
-    if umax < rect[0] || umin > rect[2] || vmax < rect[1] || vmin > rect[3] {
-        return Some(None);
-    }
-    Some(Some((vmin, vmax)))
-}
-
-/// Clips the rectangle `[u0, u1] x [v0, v1]` by `hps`; returns the row range
-/// `(v_min, v_max)` of the result, `None` when empty.
-fn clip(
+/// Clips the rectangle `[u0, v0, u1, v1]` by `hps` (Sutherland-Hodgman); returns the
+/// bounding box `[u_min, v_min, u_max, v_max]` of the result, `None` when empty.
+fn clip_bbox(
     rect: [f64; 4],
     hps: &[Hp],
     poly: &mut Vec<(f64, f64)>,
     tmp: &mut Vec<(f64, f64)>,
-) -> Option<(f64, f64)> {
+) -> Option<[f64; 4]> {
     let [u0, v0, u1, v1] = rect;
     if !(u0 <= u1 && v0 <= v1) {
         return None;
@@ -482,33 +730,37 @@ fn clip(
             return None;
         }
     }
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for &(_, v) in poly.iter() {
-        lo = lo.min(v);
-        hi = hi.max(v);
+    let mut bb = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for &(u, v) in poly.iter() {
+        bb = [bb[0].min(u), bb[1].min(v), bb[2].max(u), bb[3].max(v)];
     }
-    Some((lo, hi))
+    Some(bb)
 }
 
-/// Sites are processed in chunks of this many, so that a chunk's data stays in cache
-/// while it is rasterized into every slice of a block.
-const SITE_CHUNK: usize = 256;
-
-/// Slice buffers of one block should fit in about this many bytes (a core's L2).
-const BLOCK_BYTES: usize = 768 << 10;
-
-/// Computes the field into `out` (length `grid.len()`, C order) from `sites`.
-///
-/// Slices are grouped into blocks of consecutive slices (in parallel); within a block
-/// the sites are taken in chunks, and each chunk is turned into polygons and
-/// rasterized slice by slice, so site data and slice buffers stay in cache.
-pub(crate) fn run(sites: &Sites, grid: &Grid, band: Option<f64>, out: &mut [f32]) -> LinfacRun {
+/// Computes the field into `out` (length `grid.len()`, C order) from `sites`; `cull`
+/// is the primitive set whose nearest queries bound the tiles (no culling if `None`).
+pub(crate) fn run(
+    sites: &Sites,
+    grid: &Grid,
+    band: Option<f64>,
+    cull: Option<&AnySet>,
+    out: &mut [f32],
+) -> LinfacRun {
     let t = Instant::now();
-    let raster = Raster::new(sites, grid);
+    let raster = Raster::new(sites, grid, cull);
     let ranges: Vec<(usize, usize)> = (0..sites.sites.len())
         .into_par_iter()
         .map_init(Scratch::default, |s, idx| raster.slice_range(idx, s))
         .collect();
+    let candidates: u64 = ranges
+        .iter()
+        .map(|&(a, b)| if a <= b { (b - a + 1) as u64 } else { 0 })
+        .sum();
     // Slice range of each chunk of sites.
     let chunk_ranges: Vec<(usize, usize)> = ranges
         .chunks(SITE_CHUNK)
@@ -536,13 +788,16 @@ pub(crate) fn run(sites: &Sites, grid: &Grid, band: Option<f64>, out: &mut [f32]
     out.par_chunks_mut(block * slice_len)
         .enumerate()
         .for_each_init(
-            || (Scratch::default(), Vec::new()),
-            |(s, buf), (b, out_block)| {
+            || (Scratch::default(), Vec::new(), Bounds::default()),
+            |(s, buf, bounds), (b, out_block)| {
                 let k_first = b * block;
                 let nk = out_block.len() / slice_len;
+                let t0 = Instant::now();
                 buf.clear();
                 buf.resize(nk * slice_len, f64::INFINITY);
-                let (mut dom, mut ras, mut n_eval, mut n_poly) = (0u64, 0u64, 0u64, 0u64);
+                raster.tile_bounds(k_first, nk, bounds);
+                let mut dom = t0.elapsed().as_nanos() as u64;
+                let (mut ras, mut n_eval, mut n_poly) = (0u64, 0u64, 0u64);
                 for (c, (chunk, &(c0, c1))) in
                     ranges.chunks(SITE_CHUNK).zip(&chunk_ranges).enumerate()
                 {
@@ -552,7 +807,7 @@ pub(crate) fn run(sites: &Sites, grid: &Grid, band: Option<f64>, out: &mut [f32]
                             continue;
                         }
                         let t0 = Instant::now();
-                        raster.slice_jobs(k, c * SITE_CHUNK, chunk, s);
+                        raster.slice_jobs(k, dk, c * SITE_CHUNK, chunk, bounds, s);
                         let t1 = Instant::now();
                         n_eval +=
                             raster.slice_raster(s, &mut buf[dk * slice_len..(dk + 1) * slice_len]);
@@ -584,6 +839,7 @@ pub(crate) fn run(sites: &Sites, grid: &Grid, band: Option<f64>, out: &mut [f32]
         raster_cpu: ras_ns.into_inner() as f64 * 1e-9,
         evaluations: evals.into_inner(),
         polygons: polys.into_inner(),
+        candidates,
     }
 }
 
@@ -624,8 +880,8 @@ mod tests {
             inv_a: 1.0,
         }];
         let (mut p, mut q) = (Vec::new(), Vec::new());
-        let r = clip([0.0, 0.0, 2.0, 2.0], &hps, &mut p, &mut q).unwrap();
-        assert_eq!(r, (0.0, 1.0));
+        let r = clip_bbox([0.0, 0.0, 2.0, 2.0], &hps, &mut p, &mut q).unwrap();
+        assert_eq!(r, [0.0, 0.0, 1.0, 1.0]);
         assert_eq!(p.len(), 3);
         let hps = [Hp {
             a: 1.0,
@@ -633,6 +889,6 @@ mod tests {
             c: -0.5,
             inv_a: 1.0,
         }];
-        assert!(clip([0.0, 0.0, 2.0, 2.0], &hps, &mut p, &mut q).is_none());
+        assert!(clip_bbox([0.0, 0.0, 2.0, 2.0], &hps, &mut p, &mut q).is_none());
     }
 }

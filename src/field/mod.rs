@@ -34,6 +34,9 @@
 //! gives `d(x) >= d(v) - |x - v|` over the 8 surrounding voxel centres `v`, which a
 //! sphere tracer can use to skip empty space (SPEC 7).
 
+// `!(x > 0.0)` is the NaN policy of this module: a NaN takes the rejecting branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 mod error;
 mod grid;
 mod linfac;
@@ -82,14 +85,29 @@ impl Method {
 }
 
 /// Options shared by the methods.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FieldOptions {
     /// Narrow band: exact values where `d <= band`, `+inf` elsewhere. Exact methods only.
     pub band: Option<f64>,
     /// Linfac domains (tight by default).
     pub domains: Domains,
+    /// Linfac: cut every polygon to the tiles of the slice it can win, using per-tile
+    /// upper bounds from exact nearest queries at tile centres (default on; ignored with
+    /// a band, which already bounds every domain).
+    pub cull: bool,
     /// Memory limit in bytes (default: half the physical memory, at most 8 GiB).
     pub memory_limit: Option<u64>,
+}
+
+impl Default for FieldOptions {
+    fn default() -> Self {
+        FieldOptions {
+            band: None,
+            domains: Domains::Tight,
+            cull: true,
+            memory_limit: None,
+        }
+    }
 }
 
 /// What a computation cost.
@@ -99,7 +117,8 @@ pub struct FieldStats {
     pub voxels: usize,
     /// Wall seconds, everything included.
     pub seconds: f64,
-    /// Building the sites (linfac) or the primitive set and its BVH (other methods).
+    /// Building the sites (and, with culling, the BVH) for linfac, or the primitive set
+    /// and its BVH for the other methods.
     pub setup_seconds: f64,
     /// Linfac: per-site slice ranges plus the per-slice domain clipping (the slice loop's
     /// wall time split in proportion to the thread-summed time of its two phases).
@@ -114,8 +133,11 @@ pub struct FieldStats {
     pub site_counts: SiteCounts,
     /// Distance evaluations: pixels rasterized (linfac) or voxels queried.
     pub evaluations: u64,
-    /// Linfac: (site, slice) pairs with a non-empty polygon.
+    /// Linfac: (site, slice) pairs rasterized (non-empty polygon, not culled).
     pub polygons: u64,
+    /// Linfac: (site, slice) pairs within the sites' slice ranges, i.e. domain
+    /// computations.
+    pub candidates: u64,
 }
 
 impl FieldStats {
@@ -195,8 +217,15 @@ pub fn compute(
             let t = Instant::now();
             let eta = 1e-8 * scene_scale(mesh, &grid);
             let sites = sites::build_sites(mesh, kind, options.domains, band, eta);
+            // With a band every domain is already bounded by it; culling then costs more
+            // than it saves (measured), so it only runs without a band.
+            let set = if options.cull && band.is_none() {
+                Some(AnySet::build(mesh, kind)?)
+            } else {
+                None
+            };
             stats.setup_seconds = t.elapsed().as_secs_f64();
-            let run = linfac::run(&sites, &grid, band, &mut values);
+            let run = linfac::run(&sites, &grid, band, set.as_ref(), &mut values);
             let cpu = run.domain_cpu + run.raster_cpu;
             let share = if cpu > 0.0 { run.domain_cpu / cpu } else { 0.0 };
             stats.domain_seconds = run.range_seconds + run.slice_seconds * share;
@@ -205,6 +234,7 @@ pub fn compute(
             stats.site_counts = sites.counts;
             stats.evaluations = run.evaluations;
             stats.polygons = run.polygons;
+            stats.candidates = run.candidates;
         }
         _ => {
             let t = Instant::now();

@@ -85,7 +85,7 @@ pub(crate) enum SiteKind {
 pub(crate) struct Site {
     pub kind: SiteKind,
     /// `D(p) = (rows[r] . (p - anchor))_r` for the first 1 (face), 2 (edge) or 3 (vertex)
-    /// rows.
+    /// rows. A face's `anchor`, `rows[1]`, `rows[2]` are its three corners.
     pub anchor: DVec3,
     pub rows: [DVec3; 3],
     /// Range of this site's half-spaces in [`Sites::planes`].
@@ -120,6 +120,8 @@ pub(crate) struct Sites {
     /// Band plus margin: every site's distance is cut to it row by row; `None` without
     /// band.
     pub band: Option<f64>,
+    /// The domain margin.
+    pub eta: f64,
 }
 
 /// Builds the sites of `kind` from `mesh`. `eta` is the domain margin, `band` the
@@ -135,6 +137,7 @@ pub(crate) fn build_sites(
     let mut b = Builder {
         out: Sites {
             band: band.map(|b| b + eta),
+            eta,
             ..Sites::default()
         },
         band,
@@ -304,7 +307,7 @@ impl Builder {
         self.push(
             SiteKind::Face,
             a,
-            [n, DVec3::ZERO, DVec3::ZERO],
+            [n, b, c],
             first,
             (a + b + c) / 3.0,
             (a.min(b).min(c), a.max(b).max(c)),
