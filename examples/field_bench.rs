@@ -323,7 +323,8 @@ fn main() {
                 );
                 if args.verbose {
                     println!(
-                        "    polygons {} ({:.2} per voxel, {:.1} evaluations per polygon)",
+                        "    {} site-slice candidates, {} polygons ({:.2} per voxel, {:.1} evaluations per polygon)",
+                        s.candidates,
                         s.polygons,
                         s.polygons as f64 / s.voxels as f64,
                         s.evaluations as f64 / s.polygons.max(1) as f64

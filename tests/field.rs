@@ -957,3 +957,23 @@ fn random_sweep_of_meshes_grids_and_rotations() {
         }
     }
 }
+
+#[test]
+fn a_band_beyond_every_distance_changes_nothing() {
+    let m = fin();
+    let grid = Grid::around(m.bounds(), 12).unwrap();
+    for kind in KINDS {
+        let exact = run(&m, kind, &grid, Method::Linfac, &opts(None, Domains::Tight));
+        for band in [1e3, 1e200, f64::MAX] {
+            let f = run(
+                &m,
+                kind,
+                &grid,
+                Method::Linfac,
+                &opts(Some(band), Domains::Tight),
+            );
+            assert_eq!(f.values, exact.values, "{kind} band {band}");
+            assert_eq!(f.band, Some(band));
+        }
+    }
+}

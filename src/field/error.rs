@@ -33,7 +33,7 @@ pub enum FieldError {
     #[error("the band must be a positive, finite distance (got {0})")]
     BadBand(f64),
     #[error(
-        "a {nx}x{ny}x{nz} grid ({voxels} voxels) would need {} of memory, above the limit of {} ({why}); lower the resolution, shrink the bounds, or use a band with a coarser grid",
+        "a {nx}x{ny}x{nz} grid ({voxels} voxels) and its mesh would need {} of memory, above the limit of {} ({why}); lower the resolution or shrink the bounds",
         human_bytes(*bytes), human_bytes(*limit)
     )]
     TooMuchMemory {

@@ -161,9 +161,9 @@ impl Grid {
             .checked_add(slice.checked_mul(12)?.checked_mul(threads.max(1) as u64)?)
     }
 
-    /// Refuses a grid whose memory estimate exceeds `limit` (or, by default, half of the
-    /// physical memory capped at 8 GiB).
-    pub fn check_memory(&self, limit: Option<u64>) -> Result<(), FieldError> {
+    /// Refuses a grid whose memory estimate plus `extra` bytes exceeds `limit` (or, by
+    /// default, half of the physical memory capped at 8 GiB).
+    pub fn check_memory(&self, limit: Option<u64>, extra: u64) -> Result<(), FieldError> {
         let (limit, why) = match limit {
             Some(l) => (l, "the configured limit".to_string()),
             None => default_memory_limit(),
@@ -172,7 +172,9 @@ impl Grid {
         let voxels = (self.res[0] as u64)
             .saturating_mul(self.res[1] as u64)
             .saturating_mul(self.res[2] as u64);
-        let bytes = self.memory_estimate(threads).unwrap_or(u64::MAX);
+        let bytes = self
+            .memory_estimate(threads)
+            .map_or(u64::MAX, |b| b.saturating_add(extra));
         if bytes > limit {
             return Err(FieldError::TooMuchMemory {
                 nx: self.res[0],

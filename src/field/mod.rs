@@ -22,13 +22,19 @@
 //!   minimum over sites whose domains cover a voxel is the exact distance, because the
 //!   domain of the true closest feature always covers it and every site reports at
 //!   least the distance to its own feature (minus a 1e-8 relative robustness margin).
-//! - `Bvh`: one exact nearest-primitive query per voxel on the engine's BVH.
+//!   Culling ([`FieldOptions::cull`], without band): per-tile upper bounds of the
+//!   distance (one nearest query at each tile centre, plus the tile's half diagonal)
+//!   cut each polygon to the tiles its site can win; this never removes the closest
+//!   feature, so the result stays exact. The algorithm is in `linfac.rs`, the domains
+//!   in `sites.rs`.
+//! - `Bvh`: one exact nearest-primitive query per voxel on the engine's BVH (bounded
+//!   by the previous voxel's distance plus the spacing).
 //! - `Brute`: every primitive at every voxel (tests, tiny inputs).
 //! - `Smooth`: the smooth distance of SPEC 2 (Barnes-Hut, SPEC 6) per voxel.
 //!
 //! Narrow band ([`FieldOptions::band`]): voxels with `d <= band` hold the exact distance,
 //! all others `+inf` (f32 `INFINITY`, also in the `.npy`); every linfac domain is cut to
-//! the band, and the BVH query is bounded by it.
+//! the band (exactly, row by row), and the BVH query is bounded by it.
 //!
 //! [`DistanceField::sample`] interpolates trilinearly; [`DistanceField::lower_bound`]
 //! gives `d(x) >= d(v) - |x - v|` over the 8 surrounding voxel centres `v`, which a
@@ -203,7 +209,9 @@ pub fn compute(
     }
     // Re-validate in case the grid was built by hand.
     let grid = Grid::new(grid.min, grid.max, grid.res)?;
-    grid.check_memory(options.memory_limit)?;
+    // Sites (linfac) or primitives and BVH (the others): a few hundred bytes per simplex.
+    let simplices = mesh.vertices.len() + mesh.segments.len() + 3 * mesh.triangles.len();
+    grid.check_memory(options.memory_limit, 256 * simplices as u64)?;
     let mut values = vec![0.0f32; grid.len()];
     let mut stats = FieldStats {
         method: method.name(),
@@ -215,7 +223,11 @@ pub fn compute(
         Method::Linfac => {
             check_kind(mesh, kind)?;
             let t = Instant::now();
-            let eta = 1e-8 * scene_scale(mesh, &grid);
+            let scale = scene_scale(mesh, &grid);
+            let eta = 1e-8 * scale;
+            // No distance in the computation exceeds the scene scale: a larger band
+            // changes nothing (and its square could overflow).
+            let band = band.filter(|&b| b <= scale);
             let sites = sites::build_sites(mesh, kind, options.domains, band, eta);
             // With a band every domain is already bounded by it; culling then costs more
             // than it saves (measured), so it only runs without a band.
