@@ -223,11 +223,11 @@ pub fn compute(
         Method::Linfac => {
             check_kind(mesh, kind)?;
             let t = Instant::now();
-            let scale = scene_scale(mesh, &grid);
-            let eta = 1e-8 * scale;
-            // No distance in the computation exceeds the scene scale: a larger band
-            // changes nothing (and its square could overflow).
-            let band = band.filter(|&b| b <= scale);
+            let (reach, mag) = scene_scales(mesh, &grid);
+            let eta = 1e-8 * reach + 1e-12 * mag;
+            // No distance in the computation exceeds `reach`: a larger band changes
+            // nothing (and its square could overflow).
+            let band = band.filter(|&b| b <= 2.0 * reach);
             let sites = sites::build_sites(mesh, kind, options.domains, band, eta);
             // With a band every domain is already bounded by it; culling then costs more
             // than it saves (measured), so it only runs without a band.
@@ -304,21 +304,19 @@ fn check_kind(mesh: &Mesh, kind: PrimitiveKind) -> Result<(), PrimitiveError> {
     }
 }
 
-/// Coordinate scale of the computation: largest coordinate magnitude plus the diagonals
-/// of the grid and the mesh. The linfac robustness margin is relative to it.
-fn scene_scale(mesh: &Mesh, grid: &Grid) -> f64 {
+/// Scales of the computation: an upper bound of every distance between a voxel centre
+/// and a mesh point, and the largest coordinate magnitude. The linfac robustness margin
+/// is relative to the first (domain directions err by up to 1e-9 rad on nearly
+/// degenerate triangles) plus a tiny multiple of the second (rounding of coordinates).
+fn scene_scales(mesh: &Mesh, grid: &Grid) -> (f64, f64) {
     let b = mesh.bounds();
     let (mmin, mmax) = if b.is_empty() {
         (glam::DVec3::ZERO, glam::DVec3::ZERO)
     } else {
         (b.min.as_dvec3(), b.max.as_dvec3())
     };
-    let mag = grid
-        .min
-        .abs()
-        .max(grid.max.abs())
-        .max(mmin.abs())
-        .max(mmax.abs())
-        .length();
-    mag + grid.diagonal() + (mmax - mmin).length()
+    let reach = (0.5 * (grid.min + grid.max) - 0.5 * (mmin + mmax)).length()
+        + 0.5 * (grid.diagonal() + (mmax - mmin).length());
+    let mag = grid.min.abs().max(grid.max.abs()).max(mmin.abs()).max(mmax.abs()).length();
+    (reach, mag)
 }

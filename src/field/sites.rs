@@ -30,11 +30,14 @@
 //! The loose (non-manifold) domains of SPEC 9 drop the tight constraints: face prisms,
 //! edge slabs, and the whole slice for a vertex.
 //!
-//! Robustness: every half-space is pushed outwards by a margin `eta` (1e-8 of the scene's
-//! coordinate scale), so rounding in the domain computation cannot drop a voxel from
-//! the domain of its closest feature. A face or edge evaluated up to `eta` outside its
-//! validity region reports the distance to its plane or line, which is below the true
-//! distance by at most `eta`, so the result is exact to `eta`.
+//! Robustness: every half-space is pushed outwards by a margin `eta` (1e-8 of the largest
+//! voxel-to-mesh distance plus 1e-12 of the largest coordinate), so rounding in the
+//! domain computation cannot drop a voxel from the domain of its closest feature. A face
+//! or edge evaluated up to `eta` outside its validity region reports the distance to its
+//! plane or line, which is below the true distance by at most `eta`, so the result is
+//! exact to `eta`. Neighbouring domains overlap by `2 eta` along their common planes
+//! (a prism's side plane is the wedge plane of the edge), which is what lets a face's
+//! cross-section be bounded by its exact corners without the margin.
 //!
 //! Narrow band: with band `b` every domain is also limited to `d <= b`: the feature's
 //! bounding box grown by `b` bounds the slices and the clipping rectangle, a face gets
