@@ -317,6 +317,12 @@ fn scene_scales(mesh: &Mesh, grid: &Grid) -> (f64, f64) {
     };
     let reach = (0.5 * (grid.min + grid.max) - 0.5 * (mmin + mmax)).length()
         + 0.5 * (grid.diagonal() + (mmax - mmin).length());
-    let mag = grid.min.abs().max(grid.max.abs()).max(mmin.abs()).max(mmax.abs()).length();
+    let mag = grid
+        .min
+        .abs()
+        .max(grid.max.abs())
+        .max(mmin.abs())
+        .max(mmax.abs())
+        .length();
     (reach, mag)
 }
