@@ -983,12 +983,19 @@ fn far_from_the_origin() {
     // Coordinates around 1e4 with a mesh of diagonal ~3: the margin must not be taken
     // relative to the coordinates' size.
     let mut m = bumpy_sphere(8, 12);
-    m.transform(Vec3::ONE, glam::Quat::from_rotation_y(0.3), Vec3::new(1.0e4, -2.0e4, 5.0e3));
+    m.transform(
+        Vec3::ONE,
+        glam::Quat::from_rotation_y(0.3),
+        Vec3::new(1.0e4, -2.0e4, 5.0e3),
+    );
     let grid = Grid::around(m.bounds(), 20).unwrap();
     let tol = TOL * m.bounds().diagonal();
     for kind in KINDS {
         let bvh = run(&m, kind, &grid, Method::Bvh, &opts(None, Domains::Tight));
-        for o in [opts(None, Domains::Tight), opts_nocull(None, Domains::Loose)] {
+        for o in [
+            opts(None, Domains::Tight),
+            opts_nocull(None, Domains::Loose),
+        ] {
             let lf = run(&m, kind, &grid, Method::Linfac, &o);
             assert_same(&lf, &bvh, tol, &format!("far {kind} {o:?}"));
         }
