@@ -5,11 +5,13 @@
 //! Data flows one way: [`mesh`] (files, [`procedural`] shapes) -> [`primitives`] (sets
 //! with valences and weights) -> [`bvh`] -> [`eval`] (smooth distance, nearest) ->
 //! [`render`] (tracer, image loop, with [`camera`] and [`matcap`]), configured by
-//! [`scene`] files. The [`reports`] (bench, sweep, stability) call the same library.
+//! [`scene`] files. The [`reports`] (bench, sweep, stability) and the exact distance
+//! volumes of [`field`] (SPEC 9) call the same library.
 
 pub mod bvh;
 pub mod camera;
 pub mod eval;
+pub mod field;
 pub mod geometry;
 pub mod matcap;
 pub mod mesh;

@@ -3,6 +3,7 @@
 //! their cause chain and exit status 2.
 
 mod bench;
+mod field;
 mod progress;
 mod query;
 mod render;
@@ -35,6 +36,8 @@ enum Command {
     Sweep(sweep::SweepArgs),
     /// Run the numerical stability suite with the stable and the naive evaluators.
     Stability(stability::StabilityArgs),
+    /// Compute a distance field on a voxel grid (.npy), exact or smooth.
+    Field(field::FieldArgs),
 }
 
 /// Parses the command line, runs the command, and maps errors to exit status 2.
@@ -46,6 +49,7 @@ pub fn run() -> ExitCode {
         Command::Bench(a) => bench::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Stability(a) => stability::run(a),
+        Command::Field(a) => field::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
