@@ -14,10 +14,9 @@
 //! computations) and polygons rasterized. Timings are the best of `--repeat` runs.
 //!
 //! Data meshes come from `data/`; when a file is missing or cannot be read yet, a
-//! procedural closed mesh (bumpy sphere) with about as many triangles stands in, and
+//! procedural closed mesh (a torus) with about as many triangles stands in, and
 //! the output says so.
 
-use glam::Vec3;
 use smoothtrace::field::{self, Domains, FieldOptions, FieldStats, Grid, Method};
 use smoothtrace::mesh::Mesh;
 use smoothtrace::primitives::PrimitiveKind;
@@ -78,43 +77,11 @@ const CASES: [Case; 5] = [
     },
 ];
 
-/// A closed bumpy UV sphere with about `triangles` triangles.
-fn bumpy_sphere(triangles: usize) -> Mesh {
-    // 2 * segments * (rings - 1) triangles with segments ~ 1.5 rings.
-    let rings = ((triangles as f64 / 3.0).sqrt().round() as usize).max(3);
-    let segments = (triangles / (2 * (rings - 1))).max(3);
-    let mut vertices = vec![Vec3::new(0.0, 1.0, 0.0)];
-    for i in 1..rings {
-        let th = std::f32::consts::PI * i as f32 / rings as f32;
-        for j in 0..segments {
-            let ph = std::f32::consts::TAU * j as f32 / segments as f32;
-            let r = 1.0
-                + 0.15 * (3.0 * ph).sin() * (2.0 * th).sin()
-                + 0.05 * (7.0 * ph).cos() * (5.0 * th).sin();
-            vertices.push(r * Vec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin()));
-        }
-    }
-    vertices.push(Vec3::new(0.0, -1.0, 0.0));
-    let last = vertices.len() as u32 - 1;
-    let idx = |i: usize, j: usize| (1 + (i - 1) * segments + j % segments) as u32;
-    let mut tris = Vec::new();
-    for j in 0..segments {
-        tris.push([0, idx(1, j + 1), idx(1, j)]);
-        tris.push([last, idx(rings - 1, j), idx(rings - 1, j + 1)]);
-    }
-    for i in 1..rings - 1 {
-        for j in 0..segments {
-            let (a, b, c, d) = (idx(i, j), idx(i, j + 1), idx(i + 1, j), idx(i + 1, j + 1));
-            tris.push([a, b, d]);
-            tris.push([a, d, c]);
-        }
-    }
-    Mesh {
-        vertices,
-        segments: Vec::new(),
-        triangles: tris,
-        name: "bumpy-sphere".into(),
-    }
+/// A closed procedural torus with about `triangles` triangles (2 x major x minor).
+fn stand_in(triangles: usize) -> Mesh {
+    let minor = ((triangles as f64 / 6.0).sqrt().round() as usize).max(3);
+    let major = (triangles / (2 * minor)).max(3);
+    smoothtrace::procedural::torus(1.0, 0.35, major, minor)
 }
 
 fn load(case: &Case) -> (Mesh, String) {
@@ -127,9 +94,9 @@ fn load(case: &Case) -> (Mesh, String) {
             (m, note)
         }
         Err(e) => {
-            let m = bumpy_sphere(case.fallback_triangles);
+            let m = stand_in(case.fallback_triangles);
             let note = format!(
-                "procedural bumpy sphere ({} tris) standing in for {}: {e}",
+                "procedural torus ({} tris) standing in for {}: {e}",
                 m.triangles.len(),
                 case.file
             );

@@ -5,12 +5,12 @@
 
 use super::object::TraceObject;
 use crate::camera::{Camera, CameraError};
-use crate::eval::{Accumulation, EvalParams};
+use crate::eval::EvalParams;
 use crate::matcap::{MatCap, MatCapError};
 use crate::mesh::{Aabb, Mesh, MeshError};
 use crate::primitives::{AnySet, PrimitiveError};
 use crate::procedural::GeneratorError;
-use crate::scene::{Evaluation, Geometry, Scene};
+use crate::scene::{Geometry, Scene};
 use std::time::Instant;
 
 /// Why a scene could not be built.
@@ -163,10 +163,7 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
         }
         drop(mesh);
         let params = EvalParams {
-            accumulation: match scene.render.evaluation {
-                Evaluation::Stable => Accumulation::Stable,
-                Evaluation::Naive => Accumulation::Naive,
-            },
+            accumulation: scene.render.evaluation,
             ..EvalParams::new(alpha, max_alpha, scene.render.beta)
         };
         steps.push(BuildStep {

@@ -29,7 +29,6 @@ use crate::camera::{Camera, CameraError};
 use crate::primitives::PrimitiveKind;
 use crate::procedural::Generator;
 use glam::DVec3;
-use serde::Deserialize;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -120,16 +119,10 @@ impl Epsilon {
     }
 }
 
-/// How the smooth distance sum is accumulated (SPEC 2).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Evaluation {
-    /// Shifted sum: never underflows (default).
-    #[default]
-    Stable,
-    /// Plain sum of `w exp(-alpha d)`, as the paper measured (alpha falloff applies).
-    Naive,
-}
+/// How the smooth distance sum is accumulated (SPEC 2): `"stable"` (shifted sum, never
+/// underflows; default) or `"naive"` (the plain sum the paper measured, with alpha
+/// falloff). The scene's `evaluation` key is the evaluator's own type.
+pub use crate::eval::Accumulation as Evaluation;
 
 /// `[[object]]`: one mesh or generated shape, its primitive sets and parameters.
 #[derive(Clone, Debug, PartialEq)]
