@@ -191,20 +191,22 @@ impl<'a> Tracer<'a> {
                 continue;
             }
             let mut alpha = obj.params.alpha;
-            let mut sample = obj.evaluate(&self.sets[k], x, alpha, coarse, false);
-            if coarse.is_some() {
-                stats.coarse_evals += 1;
-            } else {
-                stats.evals += 1;
-            }
-            stats.eval.add(&sample.stats);
+            let evaluate = |alpha: f64, stats: &mut RayStats| {
+                let sample = obj.evaluate(&self.sets[k], x, alpha, coarse, false);
+                if coarse.is_some() {
+                    stats.coarse_evals += 1;
+                } else {
+                    stats.evals += 1;
+                }
+                stats.eval.add(&sample.stats);
+                sample
+            };
+            let mut sample = evaluate(alpha, stats);
             // Alpha falloff (naive mode): a smaller alpha gives a smaller, finite s.
             while sample.s == f64::INFINITY && alpha > 1e-300 {
                 alpha /= 10.0;
-                sample = obj.evaluate(&self.sets[k], x, alpha, coarse, false);
                 stats.falloffs += 1;
-                stats.evals += 1;
-                stats.eval.add(&sample.stats);
+                sample = evaluate(alpha, stats);
             }
             if sample.s < best.s {
                 best = FieldSample {
