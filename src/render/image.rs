@@ -40,6 +40,40 @@ pub struct ImageStats {
 }
 
 impl ImageStats {
+    /// Adds one ray's work and outcome.
+    fn tally(&mut self, r: &RayResult) {
+        let st = &r.stats;
+        self.evals += st.evals as u64;
+        self.coarse_evals += st.coarse_evals as u64;
+        self.max_evals_per_ray = self.max_evals_per_ray.max(st.evals + st.coarse_evals);
+        self.leaves += st.eval.leaves() as u64;
+        self.nodes += st.eval.nodes as u64;
+        self.falloffs += st.falloffs as u64;
+        self.backtracks += st.backtracks as u64;
+        self.exhausted += st.exhausted as u64;
+        if r.hit.is_some() {
+            self.hits += 1;
+            self.hit_evals += st.evals as u64;
+        } else {
+            self.misses += 1;
+        }
+    }
+
+    /// Adds the counts of another part of the image.
+    fn merge(&mut self, o: &ImageStats) {
+        self.hits += o.hits;
+        self.misses += o.misses;
+        self.exhausted += o.exhausted;
+        self.evals += o.evals;
+        self.coarse_evals += o.coarse_evals;
+        self.hit_evals += o.hit_evals;
+        self.max_evals_per_ray = self.max_evals_per_ray.max(o.max_evals_per_ray);
+        self.leaves += o.leaves;
+        self.nodes += o.nodes;
+        self.falloffs += o.falloffs;
+        self.backtracks += o.backtracks;
+    }
+
     pub fn evals_per_ray(&self) -> f64 {
         self.evals as f64 / self.rays.max(1) as f64
     }
@@ -100,46 +134,37 @@ pub fn render(
         };
     }
     let done = std::sync::atomic::AtomicU64::new(0);
-    let rows: Vec<Vec<RayResult>> = (0..h)
+    // Each row is traced, shaded and tallied on its own, so only its pixels are kept.
+    let rows: Vec<(Vec<[u8; 3]>, Vec<f32>, ImageStats)> = (0..h)
         .into_par_iter()
         .map(|py| {
-            let row = (0..w)
-                .map(|px| {
-                    let (o, d) = camera.ray(px, py);
-                    tracer.trace(o, d, s0)
-                })
-                .collect();
-            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            progress(n);
-            row
-        })
-        .collect();
-    for (py, row) in rows.iter().enumerate() {
-        for (px, r) in row.iter().enumerate() {
-            let st = &r.stats;
-            stats.evals += st.evals as u64;
-            stats.coarse_evals += st.coarse_evals as u64;
-            stats.max_evals_per_ray = stats.max_evals_per_ray.max(st.evals + st.coarse_evals);
-            stats.leaves += st.eval.leaves() as u64;
-            stats.nodes += st.eval.nodes as u64;
-            stats.falloffs += st.falloffs as u64;
-            stats.backtracks += st.backtracks as u64;
-            stats.exhausted += st.exhausted as u64;
-            match r.hit {
-                Some(hit) => {
-                    stats.hits += 1;
-                    stats.hit_evals += st.evals as u64;
+            let mut colours = vec![background; w as usize];
+            let mut row_depth = vec![f32::INFINITY; w as usize];
+            let mut row_stats = ImageStats::default();
+            for px in 0..w {
+                let (o, d) = camera.ray(px, py);
+                let r = tracer.trace(o, d, s0);
+                row_stats.tally(&r);
+                if let Some(hit) = r.hit {
                     let n = camera.to_camera_space(hit.normal);
-                    let c = shaders
+                    colours[px as usize] = shaders
                         .get(hit.object)
                         .map(|m| m.shade(n))
                         .unwrap_or([255, 0, 255]);
-                    image.put_pixel(px as u32, py as u32, image::Rgb(c));
-                    depth[py * w as usize + px] = hit.t as f32;
+                    row_depth[px as usize] = hit.t as f32;
                 }
-                None => stats.misses += 1,
             }
+            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(n);
+            (colours, row_depth, row_stats)
+        })
+        .collect();
+    for (py, (colours, row_depth, row_stats)) in rows.into_iter().enumerate() {
+        for (px, c) in colours.into_iter().enumerate() {
+            image.put_pixel(px as u32, py as u32, image::Rgb(c));
         }
+        depth[py * w as usize..(py + 1) * w as usize].copy_from_slice(&row_depth);
+        stats.merge(&row_stats);
     }
     stats.seconds = start.elapsed().as_secs_f64();
     Rendered {
