@@ -6,8 +6,6 @@
 //! major direction and 36 around the minor one, 72 segments, every vertex of valence 4.
 
 use crate::mesh::Mesh;
-use glam::Vec3;
-use std::f32::consts::TAU;
 
 /// Sides of each ring.
 const SIDES: usize = 6;
@@ -16,16 +14,10 @@ const SIDES: usize = 6;
 ///
 /// Expects `0 < minor_radius < major_radius` (checked by [`super::Generator::build`]).
 pub fn hex_torus(major_radius: f32, minor_radius: f32) -> Mesh {
+    // The vertices are those of a 6 x 6 torus grid (vertex (i, j) at index i * 6 + j);
+    // the wireframe keeps its grid edges instead of its triangles.
+    let grid = super::torus(major_radius, minor_radius, SIDES, SIDES);
     let index = |i: usize, j: usize| ((i % SIDES) * SIDES + (j % SIDES)) as u32;
-    let mut vertices = Vec::with_capacity(SIDES * SIDES);
-    for i in 0..SIDES {
-        let (sp, cp) = (TAU * i as f32 / SIDES as f32).sin_cos();
-        for j in 0..SIDES {
-            let (st, ct) = (TAU * j as f32 / SIDES as f32).sin_cos();
-            let ring = major_radius + minor_radius * ct;
-            vertices.push(Vec3::new(ring * cp, minor_radius * st, ring * sp));
-        }
-    }
     let mut segments = Vec::with_capacity(2 * SIDES * SIDES);
     for i in 0..SIDES {
         for j in 0..SIDES {
@@ -34,7 +26,7 @@ pub fn hex_torus(major_radius: f32, minor_radius: f32) -> Mesh {
         }
     }
     Mesh {
-        vertices,
+        vertices: grid.vertices,
         segments,
         triangles: Vec::new(),
         name: "hex_torus".into(),
