@@ -37,6 +37,7 @@ pub fn hex_torus(major_radius: f32, minor_radius: f32) -> Mesh {
 mod tests {
     use super::*;
     use crate::procedural::check::*;
+    use glam::Vec3;
 
     #[test]
     fn counts_and_valence() {
