@@ -16,8 +16,9 @@
 //! 5. Far from the surface, steps use a coarser Barnes-Hut sum (`coarse_beta`, cheaper,
 //!    and a lower bound of the scene's sum, so the steps stay safe) until it falls below
 //!    `coarse_threshold * epsilon`; from there on the scene's own beta decides the hit.
-//!    On the Table 1 scenes this halves the leaves visited per ray at beta 0.5 and
-//!    changes no pixel beyond silhouette rays that pass within epsilon.
+//!    On the Table 1 scenes this cut the leaves visited per ray by 15-50% at beta 0.5 and
+//!    changed no pixel beyond silhouette rays that pass within epsilon (measured on bowl,
+//!    bunny, torus, points and lidar scenes at 320x180 with `--coarse-beta 0` and 4).
 //! 6. The normal is the normalised gradient at the hit. Steps need only the value, so
 //!    they use value-only evaluations; one evaluation with the gradient is made at the
 //!    hit (the ideal ray costs one such evaluation plus its steps).
