@@ -166,7 +166,7 @@ impl AnySet {
 
     /// Approximate heap memory of the set (primitives and BVH), bytes.
     pub fn memory_bytes(&self) -> usize {
-        with_set!(self, s => s.prims.len() * std::mem::size_of_val(&s.prims[0]) + s.bvh.memory_bytes())
+        with_set!(self, s => std::mem::size_of_val(s.prims.as_slice()) + s.bvh.memory_bytes())
     }
 }
 
