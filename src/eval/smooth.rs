@@ -5,10 +5,10 @@
 //! - prune: if `r > m + (ln(N w_max / tol) - ln S) / alpha`, where `m` is the smallest
 //!   exact distance seen, `S` the shifted sum so far (a lower bound of `ln S` from its
 //!   binary exponent) and `N` the total primitive count, every term below the node is
-//!   smaller than `tol S / N`, so all pruned subtrees together hold less than `tol = 1e-10`
-//!   of the final sum. They are skipped, and when anything was pruned the sum is
+//!   smaller than `tol S / N`, so all pruned subtrees together hold less than `tol`
+//!   (`EvalParams::prune_tolerance`, 1e-10 by default) of the final sum. They are skipped, and when anything was pruned the sum is
 //!   multiplied by `1 + 2 tol` to cover them from above: `s` stays a lower bound of the
-//!   exact value and within `2e-10 / alpha` of it. The nearest primitive is never pruned,
+//!   exact value and within `2 tol / alpha` of it. The nearest primitive is never pruned,
 //!   so `s <= d_min` holds exactly. This is what makes beta = 0 cheap at large alpha.
 //!   `EvalParams::prune = false` turns it off (the paper's traversal).
 //! - far field: if the node is not a leaf and `diam(B) < beta r`, add one term
@@ -21,7 +21,11 @@ use super::accumulate::{Accumulation, Accumulator};
 use crate::primitives::{AnySet, Primitive, PrimitiveSet, WeightScale};
 use glam::DVec3;
 
-/// Relative size of the sum that pruned subtrees may add up to at most.
+/// Relative size of the sum that pruned subtrees may add up to at most, by default
+/// (queries, reports, the Python API): `s` is then within `2e-10 / alpha` of the exact
+/// value. The tracer passes a larger one tied to its hit threshold (see
+/// `render::tracer`): for a step or a hit test only `s` to a small share of epsilon
+/// matters, and pruning more is what makes soft point clouds cheaper.
 pub const PRUNE_TOLERANCE: f64 = 1e-10;
 
 /// Parameters of one smooth-distance evaluation.
@@ -34,8 +38,15 @@ pub struct EvalParams {
     /// Barnes-Hut opening parameter in [0, 1]; 0 sums every term exactly.
     pub beta: f64,
     pub accumulation: Accumulation,
-    /// Skip subtrees whose contribution is below `PRUNE_TOLERANCE` (default on).
+    /// Skip subtrees whose contribution is below `prune_tolerance` (default on).
     pub prune: bool,
+    /// Share of the sum the pruned subtrees may hold together, in (0, 0.5]
+    /// (`PRUNE_TOLERANCE` by default); `s` stays a lower bound of the exact value and
+    /// within `2 prune_tolerance / alpha` of it.
+    pub prune_tolerance: f64,
+    /// Far-field terms from the node's centroid and spread as well as its box
+    /// (`primitives::moments`, default on); off, the box alone (the paper's term).
+    pub tight_far_field: bool,
 }
 
 impl EvalParams {
@@ -46,6 +57,8 @@ impl EvalParams {
             beta,
             accumulation: Accumulation::Stable,
             prune: true,
+            prune_tolerance: PRUNE_TOLERANCE,
+            tight_far_field: true,
         }
     }
 }
@@ -113,7 +126,7 @@ fn evaluate_impl<const GRAD: bool>(sets: &[&AnySet], x: DVec3, p: &EvalParams) -
         .map(|s| scale(s).max_weight())
         .fold(1.0, f64::max);
     let prune_margin = if p.prune {
-        (total.max(1) as f64 * w_max / PRUNE_TOLERANCE).ln() / p.alpha
+        (total.max(1) as f64 * w_max / p.prune_tolerance).ln() / p.alpha
     } else {
         f64::INFINITY
     };
@@ -122,9 +135,9 @@ fn evaluate_impl<const GRAD: bool>(sets: &[&AnySet], x: DVec3, p: &EvalParams) -
         crate::with_set!(set, s => traverse::<_, GRAD>(s, x, p, &sc, prune_margin, &mut acc, &mut stats));
     }
     if stats.pruned > 0 {
-        // The pruned subtrees hold less than PRUNE_TOLERANCE of the final sum (see the
+        // The pruned subtrees hold less than the tolerance of the final sum (see the
         // module docs): add that bound back so s never exceeds the exact value.
-        acc.inflate(1.0 + 2.0 * PRUNE_TOLERANCE);
+        acc.inflate(1.0 + 2.0 * p.prune_tolerance);
     }
     let (s, grad, underflow) = acc.finish();
     Sample {
@@ -186,10 +199,19 @@ fn traverse<P: Primitive, const GRAD: bool>(
         }
         let diam = node.diam as f64;
         if p.beta > 0.0 && diam * diam < beta2 * r2 {
-            let r = r2.sqrt();
+            let r_box = r2.sqrt();
+            // The centroid bound can only win for nodes of moderate size against 1/alpha
+            // (see `primitives::moments`): below, the box bound loses little; above,
+            // the exponential of the node's extent swamps the spread term.
+            let a_diam = p.alpha * diam;
+            let r = if p.tight_far_field && (0.25..=6.0).contains(&a_diam) {
+                set.moments[i as usize].far_distance(node, x, r_box, p.alpha)
+            } else {
+                r_box
+            };
             if GRAD {
                 let (_, c) = node.distance(x);
-                acc.add(r, node.size as f64 * w_ff, (x - c) / r, DVec3::ZERO);
+                acc.add(r, node.size as f64 * w_ff, (x - c) / r_box, DVec3::ZERO);
             } else {
                 acc.add_value(r, node.size as f64 * w_ff);
             }

@@ -4,6 +4,7 @@
 use serde::Deserialize;
 
 mod kinds;
+pub mod moments;
 mod sets;
 pub mod weights;
 

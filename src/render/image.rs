@@ -1,13 +1,18 @@
-//! The image loop: one ray per pixel centre, traced in parallel by rows, shaded with the
-//! hit object's MatCap (SPEC 8) using the camera-space normal. Pixels are independent,
-//! so the image does not depend on the thread count.
+//! The image loop: one ray per pixel centre, traced in parallel by tiles of
+//! `TILE x TILE` pixels (each marched as a cone first, `cone`), shaded with the hit
+//! object's MatCap (SPEC 8) using the camera-space normal. A tile's work does not depend
+//! on the other tiles, so the image does not depend on the thread count.
 
+use super::cone::{ConeStats, Tile, trace_tile};
 use super::tracer::{RayResult, Tracer};
 use crate::camera::Camera;
 use crate::matcap::MatCap;
 use image::RgbImage;
 use rayon::prelude::*;
 use std::time::Instant;
+
+/// Side of the square pixel tiles traced as a unit (and marched as one cone first).
+pub const TILE: u32 = 16;
 
 /// Per-image statistics (SPEC 7).
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
@@ -28,12 +33,21 @@ pub struct ImageStats {
     pub max_evals_per_ray: u32,
     /// Exact plus far-field terms over all evaluations.
     pub leaves: u64,
+    /// Leaves visited by the coarse evaluations (included in `leaves`).
+    pub coarse_leaves: u64,
+    /// Coarse evaluations over the rays that hit.
+    pub hit_coarse_evals: u64,
+    /// Leaves visited over the rays that hit.
+    pub hit_leaves: u64,
     /// BVH nodes visited over all evaluations.
     pub nodes: u64,
     pub falloffs: u64,
     pub backtracks: u64,
     /// The camera origin is inside the surface (the image is all background).
     pub camera_inside: bool,
+    /// Bound evaluations on tile axes (cone marching), shared by the tile's rays;
+    /// included in `coarse_evals` and their leaves in `leaves` and `coarse_leaves`.
+    pub tile_evals: u64,
     /// Wall-clock seconds of the tracing loop.
     pub seconds: f64,
     pub threads: usize,
@@ -47,6 +61,7 @@ impl ImageStats {
         self.coarse_evals += st.coarse_evals as u64;
         self.max_evals_per_ray = self.max_evals_per_ray.max(st.evals + st.coarse_evals);
         self.leaves += st.eval.leaves() as u64;
+        self.coarse_leaves += st.coarse_leaves as u64;
         self.nodes += st.eval.nodes as u64;
         self.falloffs += st.falloffs as u64;
         self.backtracks += st.backtracks as u64;
@@ -54,6 +69,8 @@ impl ImageStats {
         if r.hit.is_some() {
             self.hits += 1;
             self.hit_evals += st.evals as u64;
+            self.hit_coarse_evals += st.coarse_evals as u64;
+            self.hit_leaves += st.eval.leaves() as u64;
         } else {
             self.misses += 1;
         }
@@ -69,9 +86,22 @@ impl ImageStats {
         self.hit_evals += o.hit_evals;
         self.max_evals_per_ray = self.max_evals_per_ray.max(o.max_evals_per_ray);
         self.leaves += o.leaves;
+        self.coarse_leaves += o.coarse_leaves;
+        self.hit_coarse_evals += o.hit_coarse_evals;
+        self.hit_leaves += o.hit_leaves;
         self.nodes += o.nodes;
         self.falloffs += o.falloffs;
         self.backtracks += o.backtracks;
+        self.tile_evals += o.tile_evals;
+    }
+
+    /// Adds the shared work of tile marches.
+    fn add_cones(&mut self, c: &ConeStats) {
+        self.tile_evals += c.evals;
+        self.coarse_evals += c.evals;
+        self.leaves += c.leaves;
+        self.coarse_leaves += c.leaves;
+        self.nodes += c.nodes;
     }
 
     pub fn evals_per_ray(&self) -> f64 {
@@ -133,39 +163,66 @@ pub fn render(
             stats,
         };
     }
-    let done = std::sync::atomic::AtomicU64::new(0);
-    // Each row is traced, shaded and tallied on its own, so only its pixels are kept.
-    let rows: Vec<(Vec<[u8; 3]>, Vec<f32>, ImageStats)> = (0..h)
-        .into_par_iter()
-        .map(|py| {
-            let mut colours = vec![background; w as usize];
-            let mut row_depth = vec![f32::INFINITY; w as usize];
-            let mut row_stats = ImageStats::default();
-            for px in 0..w {
-                let (o, d) = camera.ray(px, py);
-                let r = tracer.trace(o, d, s0);
-                row_stats.tally(&r);
-                if let Some(hit) = r.hit {
-                    let n = camera.to_camera_space(hit.normal);
-                    colours[px as usize] = shaders
-                        .get(hit.object)
-                        .map(|m| m.shade(n))
-                        .unwrap_or([255, 0, 255]);
-                    row_depth[px as usize] = hit.t as f32;
-                }
-            }
-            let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            progress(n);
-            (colours, row_depth, row_stats)
+    let cone = tracer.options().cone;
+    let tiles: Vec<Tile> = (0..h.div_ceil(TILE))
+        .flat_map(|ty| {
+            (0..w.div_ceil(TILE)).map(move |tx| Tile {
+                x0: tx * TILE,
+                y0: ty * TILE,
+                w: TILE.min(w - tx * TILE),
+                h: TILE.min(h - ty * TILE),
+            })
         })
         .collect();
-    for (py, (colours, row_depth, row_stats)) in rows.into_iter().enumerate() {
-        for (px, c) in colours.into_iter().enumerate() {
-            image.put_pixel(px as u32, py as u32, image::Rgb(c));
+    let tiles_per_row = w.div_ceil(TILE) as u64;
+    let done = std::sync::atomic::AtomicU64::new(0);
+    // Each tile is traced, shaded and tallied on its own, so only its pixels are kept.
+    let results: Vec<(Tile, Vec<[u8; 3]>, Vec<f32>, ImageStats)> = tiles
+        .into_par_iter()
+        .map(|tile| {
+            let n = (tile.w * tile.h) as usize;
+            let mut colours = vec![background; n];
+            let mut tile_depth = vec![f32::INFINITY; n];
+            let mut tile_stats = ImageStats::default();
+            let mut cones = ConeStats::default();
+            trace_tile(
+                tracer,
+                camera,
+                tile,
+                s0,
+                cone,
+                &mut cones,
+                &mut |px, py, r| {
+                    tile_stats.tally(&r);
+                    if let Some(hit) = r.hit {
+                        let i = ((py - tile.y0) * tile.w + (px - tile.x0)) as usize;
+                        let n = camera.to_camera_space(hit.normal);
+                        colours[i] = shaders
+                            .get(hit.object)
+                            .map(|m| m.shade(n))
+                            .unwrap_or([255, 0, 255]);
+                        tile_depth[i] = hit.t as f32;
+                    }
+                },
+            );
+            tile_stats.add_cones(&cones);
+            // Progress in rows: a row of tiles counts once all its tiles are done.
+            let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            if finished % tiles_per_row == 0 {
+                progress((finished / tiles_per_row * TILE as u64).min(h as u64));
+            }
+            (tile, colours, tile_depth, tile_stats)
+        })
+        .collect();
+    for (tile, colours, tile_depth, tile_stats) in results {
+        for (i, (c, d)) in colours.into_iter().zip(tile_depth).enumerate() {
+            let (px, py) = (tile.x0 + i as u32 % tile.w, tile.y0 + i as u32 / tile.w);
+            image.put_pixel(px, py, image::Rgb(c));
+            depth[(py * w + px) as usize] = d;
         }
-        depth[py * w as usize..(py + 1) * w as usize].copy_from_slice(&row_depth);
-        stats.merge(&row_stats);
+        stats.merge(&tile_stats);
     }
+    progress(h as u64);
     stats.seconds = start.elapsed().as_secs_f64();
     Rendered {
         image,

@@ -1,5 +1,6 @@
 //! Rendering: objects ready to trace, the sphere tracer (SPEC 7), the image loop.
 
+pub mod cone;
 pub mod object;
 pub mod tracer;
 

@@ -53,20 +53,26 @@ impl TraceObject {
     }
 
     /// Evaluates the smooth distance with the object's parameters, alpha possibly
-    /// replaced (the naive mode's falloff) and beta possibly coarsened (a coarser
-    /// Barnes-Hut sum is a lower bound of a finer one), with the gradient if `grad`.
+    /// replaced (the naive mode's falloff), beta possibly coarsened (a coarser
+    /// Barnes-Hut sum is a lower bound of a finer one) and the pruning tolerance possibly
+    /// raised (a lower bound too, see `eval::smooth`), with the gradient if `grad`.
     pub fn evaluate(
         &self,
         sets: &[&AnySet],
         x: DVec3,
         alpha: f64,
         beta: Option<f64>,
+        prune_tolerance: f64,
         grad: bool,
     ) -> Sample {
         let mut p = self.params;
         p.alpha = alpha;
+        p.prune_tolerance = p.prune_tolerance.max(prune_tolerance);
         if let Some(b) = beta {
             p.beta = b.max(p.beta);
+            // At a coarse beta the far nodes are large against 1/alpha, where the
+            // centroid bound almost never beats the box one: not worth its cost there.
+            p.tight_far_field = false;
         }
         if grad {
             eval::evaluate(sets, x, &p)

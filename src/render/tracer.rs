@@ -35,13 +35,15 @@ pub struct TracerOptions {
     pub epsilon: f64,
     /// Largest number of field evaluations per ray before giving up (a miss).
     pub max_steps: u32,
-    /// Opening parameter of the cheap evaluations used for steps far from the surface
-    /// (0 = off). Any Barnes-Hut sum coarser than the scene's is a lower bound of it
-    /// (a parent's far-field term dominates everything below it), so these steps are as
+    /// Opening parameter of the cheapest bound steps, taken far from the surface (0 =
+    /// off). Any Barnes-Hut sum coarser than the scene's is a lower bound of it (a
+    /// parent's far-field term dominates everything below it), so these steps are as
     /// safe as the scene's own; the hit itself is always decided at the scene's beta.
     pub coarse_beta: f64,
     /// Coarse steps are taken while the coarse value exceeds this many epsilons.
     pub coarse_threshold: f64,
+    /// March primary-ray tiles as cones first (`cone`; needs `coarse_beta > 0`).
+    pub cone: bool,
     /// Clip rays to the grown scene box (misses outside it cost no evaluation). Off,
     /// rays start at the camera's smooth distance and march to the box's far side, as
     /// in the paper's renderer.
@@ -66,6 +68,7 @@ impl TracerOptions {
             max_steps,
             coarse_beta: 4.0,
             coarse_threshold: 4.0,
+            cone: true,
             clip: true,
             backtrack: Backtrack::Illinois,
         }
@@ -77,6 +80,7 @@ impl TracerOptions {
     pub fn paper(epsilon: f64, max_steps: u32) -> TracerOptions {
         TracerOptions {
             coarse_beta: 0.0,
+            cone: false,
             clip: false,
             backtrack: Backtrack::FixedStep,
             ..TracerOptions::new(epsilon, max_steps)
@@ -98,13 +102,15 @@ pub struct Hit {
 /// Work done for one ray.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RayStats {
-    /// Field evaluations at the scene's beta (one per object evaluated per step, plus
-    /// the gradient evaluation at the hit).
+    /// Full-accuracy field evaluations, at the scene's beta (one per object evaluated
+    /// per step; those near the surface carry the gradient the hit is shaded with).
     pub evals: u32,
-    /// Cheaper evaluations at the coarse beta (far-from-surface steps).
+    /// Bound steps: cheaper evaluations at a coarser beta (far from the surface).
     pub coarse_evals: u32,
-    /// Sum of the evaluations' statistics (leaves, nodes).
+    /// Sum of the evaluations' statistics (leaves, nodes), coarse and full together.
     pub eval: EvalStats,
+    /// Leaves visited by the coarse evaluations alone (included in `eval`).
+    pub coarse_leaves: u32,
     /// Retries with a smaller alpha after an infinite (underflowed) naive evaluation.
     pub falloffs: u32,
     /// Evaluations spent locating a crossing after overshooting into the negative band.
@@ -124,6 +130,17 @@ pub struct RayResult {
 struct FieldSample {
     s: f64,
     object: usize,
+    /// Gradient of the winning object's smooth distance, when it was asked for.
+    grad: Option<DVec3>,
+}
+
+/// What an evaluation is for: a bound step at a coarser beta, or a full-accuracy value
+/// with or without the gradient.
+#[derive(Clone, Copy, PartialEq)]
+enum Want {
+    Bound(f64),
+    Value,
+    Gradient,
 }
 
 /// Traces rays against a set of objects.
@@ -131,6 +148,10 @@ pub struct Tracer<'a> {
     objects: &'a [TraceObject],
     sets: Vec<Vec<&'a AnySet>>,
     reach: Vec<f64>,
+    /// Pruning tolerance per object: subtrees holding together less than this share of
+    /// the sum are skipped, which lowers `s` by at most `2 tol / alpha`; chosen so that
+    /// is at most 1% of epsilon (and at most 1e-3 of the sum).
+    tolerance: Vec<f64>,
     /// Union of the grown object boxes.
     min: DVec3,
     max: DVec3,
@@ -146,10 +167,15 @@ impl<'a> Tracer<'a> {
             min = min.min(o.bounds.min.as_dvec3() - r);
             max = max.max(o.bounds.max.as_dvec3() + r);
         }
+        let tolerance = objects
+            .iter()
+            .map(|o| (0.005 * o.params.alpha * options.epsilon).min(1e-3))
+            .collect();
         Tracer {
             objects,
             sets: objects.iter().map(|o| o.set_refs()).collect(),
             reach,
+            tolerance,
             min,
             max,
             options,
@@ -162,8 +188,15 @@ impl<'a> Tracer<'a> {
 
     /// The scene field at `x` (the minimum over objects) and the object attaining it.
     pub fn field(&self, x: DVec3, stats: &mut RayStats) -> (f64, usize) {
-        let f = self.sample(x, stats, None);
+        let f = self.sample(x, stats, Want::Value);
         (f.s, f.object)
+    }
+
+    /// A lower bound of the scene field at `x` from a Barnes-Hut sum at opening
+    /// parameter `beta` (at least the scene's): cheaper than [`Tracer::field`] for a
+    /// larger `beta`, counted as a bound step.
+    pub fn bound(&self, x: DVec3, beta: f64, stats: &mut RayStats) -> f64 {
+        self.sample(x, stats, Want::Bound(beta)).s
     }
 
     /// The gradient of object `k`'s smooth distance at `x` (one evaluation).
@@ -171,7 +204,7 @@ impl<'a> Tracer<'a> {
         let obj = &self.objects[k];
         let mut alpha = obj.params.alpha;
         loop {
-            let sample = obj.evaluate(&self.sets[k], x, alpha, None, true);
+            let sample = obj.evaluate(&self.sets[k], x, alpha, None, self.tolerance[k], true);
             stats.evals += 1;
             stats.eval.add(&sample.stats);
             if sample.s.is_finite() || alpha <= 1e-300 {
@@ -182,10 +215,16 @@ impl<'a> Tracer<'a> {
         }
     }
 
-    fn sample(&self, x: DVec3, stats: &mut RayStats, coarse: Option<f64>) -> FieldSample {
+    fn sample(&self, x: DVec3, stats: &mut RayStats, want: Want) -> FieldSample {
         let mut best = FieldSample {
             s: f64::INFINITY,
             object: 0,
+            grad: None,
+        };
+        let (coarse, grad) = match want {
+            Want::Bound(beta) => (Some(beta), false),
+            Want::Value => (None, false),
+            Want::Gradient => (None, true),
         };
         for (k, obj) in self.objects.iter().enumerate() {
             if self.objects.len() > 1 && obj.lower_bound(x, self.reach[k]) >= best.s {
@@ -193,9 +232,10 @@ impl<'a> Tracer<'a> {
             }
             let mut alpha = obj.params.alpha;
             let evaluate = |alpha: f64, stats: &mut RayStats| {
-                let sample = obj.evaluate(&self.sets[k], x, alpha, coarse, false);
+                let sample = obj.evaluate(&self.sets[k], x, alpha, coarse, self.tolerance[k], grad);
                 if coarse.is_some() {
                     stats.coarse_evals += 1;
+                    stats.coarse_leaves += sample.stats.leaves();
                 } else {
                     stats.evals += 1;
                 }
@@ -213,10 +253,18 @@ impl<'a> Tracer<'a> {
                 best = FieldSample {
                     s: sample.s,
                     object: k,
+                    // A falloff's gradient is that of a smaller alpha: recomputed at the hit.
+                    grad: (grad && alpha == obj.params.alpha).then_some(sample.grad),
                 };
             }
         }
         best
+    }
+
+    /// An upper bound of the ray parameter at which any ray from `o` leaves the grown
+    /// scene box: the distance to its farthest corner.
+    pub fn farthest(&self, o: DVec3) -> f64 {
+        (o - self.min).abs().max((o - self.max).abs()).length()
     }
 
     /// The parameter interval where the ray is inside the grown scene box, if any.
@@ -250,20 +298,30 @@ impl<'a> Tracer<'a> {
         let coarse = (self.options.coarse_beta > 0.0).then_some(self.options.coarse_beta);
         let tau = self.options.coarse_threshold * eps;
         let mut near = false;
+        // Full-accuracy evaluations carry the gradient when they are predicted to hit,
+        // so the hit needs no second traversal to be shaded: the next value is guessed
+        // from the last ratio of successive values (sphere tracing converges about
+        // geometrically), or from the value itself.
+        let mut ratio = 1.0;
+        let mut want = Want::Value;
         while t <= t_max {
             if stats.evals + stats.coarse_evals >= self.options.max_steps {
                 stats.exhausted = true;
                 return RayResult { hit: None, stats };
             }
-            if let (Some(_), false) = (coarse, near) {
-                let c = self.sample(o + t * d, &mut stats, coarse);
+            let x = o + t * d;
+            if let (Some(beta), false) = (coarse, near) {
+                let c = self.sample(x, &mut stats, Want::Bound(beta));
                 if c.s > tau {
                     prev = Some((t, c.s));
                     t += c.s;
                     continue;
                 }
+                if c.s <= eps {
+                    want = Want::Gradient;
+                }
             }
-            let f = self.sample(o + t * d, &mut stats, None);
+            let f = self.sample(x, &mut stats, want);
             near = f.s < 2.0 * tau;
             if f.s.abs() <= eps {
                 let hit = self.hit(o, d, t, &f, &mut stats);
@@ -283,6 +341,14 @@ impl<'a> Tracer<'a> {
                 };
                 return RayResult { hit, stats };
             }
+            if let Some((_, sp)) = prev {
+                ratio = (f.s / sp).min(1.0);
+            }
+            want = if f.s * ratio <= eps {
+                Want::Gradient
+            } else {
+                Want::Value
+            };
             prev = Some((t, f.s));
             t += f.s;
         }
@@ -291,10 +357,14 @@ impl<'a> Tracer<'a> {
 
     fn hit(&self, o: DVec3, d: DVec3, t: f64, f: &FieldSample, stats: &mut RayStats) -> Hit {
         let point = o + t * d;
+        let grad = match f.grad {
+            Some(g) => g,
+            None => self.gradient(f.object, point, stats),
+        };
         Hit {
             t,
             point,
-            normal: self.gradient(f.object, point, stats).normalize_or_zero(),
+            normal: grad.normalize_or_zero(),
             object: f.object,
         }
     }
@@ -306,7 +376,7 @@ impl<'a> Tracer<'a> {
         while stats.evals + stats.coarse_evals < self.options.max_steps {
             t -= eps;
             let before = stats.evals;
-            let f = self.sample(o + t * d, stats, None);
+            let f = self.sample(o + t * d, stats, Want::Value);
             stats.backtracks += stats.evals - before;
             if f.s >= -eps {
                 return Some(self.hit(o, d, t, &f, stats));
@@ -338,7 +408,7 @@ impl<'a> Tracer<'a> {
                 t = 0.5 * (lo + hi);
             }
             let before = stats.evals;
-            let f = self.sample(o + t * d, stats, None);
+            let f = self.sample(o + t * d, stats, Want::Value);
             stats.backtracks += stats.evals - before;
             if f.s.abs() <= eps || hi - lo <= eps {
                 return Some(self.hit(o, d, t, &f, stats));

@@ -1,0 +1,151 @@
+//! Cone marching of primary-ray tiles (SPEC 7): one bound evaluation on a tile's axis
+//! advances every ray of the tile while they are far from the surface.
+//!
+//! All rays of a tile leave the camera origin `o`. Take the tile's axis `a` (unit) and the
+//! largest angle `theta` between `a` and a ray `d_i` of the tile (attained at a corner
+//! pixel: the directions within an angle of `a` form a convex set on the image plane).
+//! At parameter `t`, every ray's point lies within `c(t) = t |d_i - a| <= 2 t sin(theta/2)`
+//! of the axis point `q = o + t a`. If the field is at least `r` at `q` (no surface in
+//! the ball of radius `r` around `q`, the assumption every sphere-tracing step makes),
+//! then each ray can advance by `r - c(t)`: its segment stays within `c(t) + (r - c(t))
+//! = r` of `q`. So the whole tile advances by `r - c(t)` with one evaluation.
+//!
+//! The evaluation is a bound step (the tracer's coarsest Barnes-Hut level, a lower bound
+//! of the scene's field), so the guarantee is the same as the per-ray steps'. When the
+//! cone radius eats more than half of the step, the tile splits into four and each
+//! quarter goes on from the same `t` with its narrower cone; single pixels (and tiles
+//! whose cone no longer advances) are traced ray by ray from the tile's `t`.
+
+use super::tracer::{RayResult, RayStats, Tracer};
+use crate::camera::Camera;
+use glam::DVec3;
+
+/// A cone step is taken only while the cone radius leaves at least this share of the
+/// axis value as the step.
+const MIN_STEP_SHARE: f64 = 0.5;
+
+/// Tiles narrower than this (in pixels, both ways) are traced ray by ray.
+const MIN_TILE: u32 = 2;
+
+/// Work done by the tile marches (shared by the rays of each tile).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ConeStats {
+    /// Bound evaluations on tile axes.
+    pub evals: u64,
+    /// Leaves visited by them.
+    pub leaves: u64,
+    /// Nodes visited by them.
+    pub nodes: u64,
+}
+
+/// A rectangle of pixels: `x0 .. x0 + w`, `y0 .. y0 + h`.
+#[derive(Clone, Copy, Debug)]
+pub struct Tile {
+    pub x0: u32,
+    pub y0: u32,
+    pub w: u32,
+    pub h: u32,
+}
+
+impl Tile {
+    fn quarters(&self) -> impl Iterator<Item = Tile> {
+        let (w0, h0) = (self.w.div_ceil(2), self.h.div_ceil(2));
+        let me = *self;
+        [
+            (0, 0, w0, h0),
+            (w0, 0, me.w - w0, h0),
+            (0, h0, w0, me.h - h0),
+            (w0, h0, me.w - w0, me.h - h0),
+        ]
+        .into_iter()
+        .filter(|q| q.2 > 0 && q.3 > 0)
+        .map(move |(dx, dy, w, h)| Tile {
+            x0: me.x0 + dx,
+            y0: me.y0 + dy,
+            w,
+            h,
+        })
+    }
+}
+
+/// Traces every pixel of `tile`, starting at `t_start` (the camera's own clearance), and
+/// calls `out(px, py, result)` for each. With `cone = false` every ray is traced on its
+/// own (the reference the cone march must reproduce).
+pub fn trace_tile(
+    tracer: &Tracer,
+    camera: &Camera,
+    tile: Tile,
+    t_start: f64,
+    cone: bool,
+    stats: &mut ConeStats,
+    out: &mut dyn FnMut(u32, u32, RayResult),
+) {
+    if !cone || tracer.options().coarse_beta <= 0.0 {
+        for py in tile.y0..tile.y0 + tile.h {
+            for px in tile.x0..tile.x0 + tile.w {
+                let (o, d) = camera.ray(px, py);
+                out(px, py, tracer.trace(o, d, t_start));
+            }
+        }
+        return;
+    }
+    march(tracer, camera, tile, t_start, stats, out);
+}
+
+fn march(
+    tracer: &Tracer,
+    camera: &Camera,
+    tile: Tile,
+    t_start: f64,
+    stats: &mut ConeStats,
+    out: &mut dyn FnMut(u32, u32, RayResult),
+) {
+    if tile.w < MIN_TILE || tile.h < MIN_TILE {
+        return trace_tile(tracer, camera, tile, t_start, false, stats, out);
+    }
+    let (o, _) = camera.ray(tile.x0, tile.y0);
+    let (x1, y1) = (tile.x0 + tile.w - 1, tile.y0 + tile.h - 1);
+    let corners = [(tile.x0, tile.y0), (x1, tile.y0), (tile.x0, y1), (x1, y1)]
+        .map(|(px, py)| camera.ray(px, py).1);
+    let axis = corners.iter().copied().sum::<DVec3>().normalize();
+    // |d_i - a| for the widest ray: the cone radius per unit of t.
+    let spread = corners
+        .iter()
+        .map(|&d| (d - axis).length())
+        .fold(0.0, f64::max);
+    // The tile's rays enter the grown scene box no earlier than the earliest corner
+    // does... which need not hold for interior rays, so start from the camera's own
+    // clearance and let the march skip the empty space.
+    let mut t = t_start;
+    let t_far = tracer.farthest(o);
+    let beta = tracer.options().coarse_beta;
+    let mut advanced = false;
+    while t <= t_far {
+        let mut ray = RayStats::default();
+        let r = tracer.bound(o + t * axis, beta, &mut ray);
+        stats.evals += ray.coarse_evals as u64;
+        stats.leaves += ray.eval.leaves() as u64;
+        stats.nodes += ray.eval.nodes as u64;
+        let step = r - spread * t;
+        if !(step > MIN_STEP_SHARE * r) {
+            break;
+        }
+        t += step;
+        advanced = true;
+    }
+    if t > t_far {
+        // Past every ray's exit from the scene box: all of them miss.
+        for py in tile.y0..tile.y0 + tile.h {
+            for px in tile.x0..tile.x0 + tile.w {
+                out(px, py, RayResult::default());
+            }
+        }
+        return;
+    }
+    if !advanced && tile.w <= 2 * MIN_TILE && tile.h <= 2 * MIN_TILE {
+        return trace_tile(tracer, camera, tile, t, false, stats, out);
+    }
+    for q in tile.quarters() {
+        march(tracer, camera, q, t, stats, out);
+    }
+}
