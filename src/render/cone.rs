@@ -127,7 +127,7 @@ fn march(
         stats.leaves += ray.eval.leaves() as u64;
         stats.nodes += ray.eval.nodes as u64;
         let step = r - spread * t;
-        if !(step > MIN_STEP_SHARE * r) {
+        if step.is_nan() || step <= MIN_STEP_SHARE * r {
             break;
         }
         t += step;

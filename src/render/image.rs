@@ -123,6 +123,9 @@ impl ImageStats {
     }
 }
 
+/// One traced tile: its colours and depths (row-major within the tile) and its work.
+type TileResult = (Tile, Vec<[u8; 3]>, Vec<f32>, ImageStats);
+
 /// A rendered image with its per-pixel hit distances.
 pub struct Rendered {
     pub image: RgbImage,
@@ -177,7 +180,7 @@ pub fn render(
     let tiles_per_row = w.div_ceil(TILE) as u64;
     let done = std::sync::atomic::AtomicU64::new(0);
     // Each tile is traced, shaded and tallied on its own, so only its pixels are kept.
-    let results: Vec<(Tile, Vec<[u8; 3]>, Vec<f32>, ImageStats)> = tiles
+    let results: Vec<TileResult> = tiles
         .into_par_iter()
         .map(|tile| {
             let n = (tile.w * tile.h) as usize;
@@ -208,7 +211,7 @@ pub fn render(
             tile_stats.add_cones(&cones);
             // Progress in rows: a row of tiles counts once all its tiles are done.
             let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            if finished % tiles_per_row == 0 {
+            if finished.is_multiple_of(tiles_per_row) {
                 progress((finished / tiles_per_row * TILE as u64).min(h as u64));
             }
             (tile, colours, tile_depth, tile_stats)
