@@ -8,6 +8,7 @@
 //! [`scene`] files. The [`reports`] (bench, sweep, stability) and the exact distance
 //! volumes of [`field`] (SPEC 9) call the same library.
 
+pub mod api;
 pub mod bvh;
 pub mod camera;
 pub mod eval;
