@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numbers
 import os
-from typing import Any, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -80,7 +80,7 @@ def _indices(a: Any, name: str, width: int) -> Optional[np.ndarray]:
 
 def _primitives(
     primitives: Union[None, str, Sequence[str]], faces: Any, edges: Any
-) -> list:
+) -> List[str]:
     """The primitive sets to build: given, or what the arrays provide."""
     if primitives is None:
         if faces is not None:
@@ -130,7 +130,9 @@ def _alpha_args(alpha, alpha_rel, max_alpha, max_alpha_rel):
     )
 
 
-def load_mesh(path: Union[str, "os.PathLike[str]"], return_edges: bool = False):
+def load_mesh(
+    path: Union[str, "os.PathLike[str]"], return_edges: bool = False
+) -> Union[Tuple[np.ndarray, np.ndarray], Tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Read a mesh file (OBJ, PLY or STL, chosen by extension).
 
     Returns ``(V, F)``: vertices ``(nv, 3)`` float64 and triangles ``(nf, 3)`` int64
@@ -213,7 +215,12 @@ class SmoothDistance:
         ``P``. The gradient includes the weights' terms (SPEC 5)."""
         return self._native.value_and_gradient(_coordinates(P, "P"), _threads(threads))
 
-    def nearest(self, P: Any, threads: Optional[int] = None, return_set: bool = False):
+    def nearest(
+        self, P: Any, threads: Optional[int] = None, return_set: bool = False
+    ) -> Union[
+        Tuple[np.ndarray, np.ndarray, np.ndarray],
+        Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    ]:
         """The exact nearest primitive to each row of ``P``.
 
         Returns ``(d, idx, closest)``: the exact distance ``(n,)`` float64, the index
@@ -243,12 +250,12 @@ class SmoothDistance:
         return self._native.beta
 
     @property
-    def primitives(self) -> list:
+    def primitives(self) -> List[str]:
         """The primitive sets summed, in order (duplicates removed)."""
         return self._native.primitives
 
     @property
-    def counts(self) -> list:
+    def counts(self) -> List[int]:
         """The number of primitives in each set."""
         return self._native.counts
 
@@ -281,7 +288,7 @@ def distance_field(
     band: Optional[float] = None,
     threads: Optional[int] = None,
     return_bounds: bool = False,
-):
+) -> Union[np.ndarray, Tuple[np.ndarray, np.ndarray]]:
     """A distance volume on a voxel grid (SPEC 9), as ``smoothtrace field`` computes it.
 
     Voxel ``(i, j, k)`` has its centre at ``min + ((i, j, k) + 0.5) * (max - min) / (nx,
@@ -338,7 +345,7 @@ def distance_field(
         _number(smooth_alpha, "smooth_alpha"),
         _number(smooth_alpha_rel, "smooth_alpha_rel"),
         _number(max_alpha, "max_alpha"),
-        _number(beta, "beta"),
+        0.5 if beta is None else _number(beta, "beta"),
         _number(band, "band"),
         _threads(threads),
     )

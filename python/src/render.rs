@@ -19,6 +19,9 @@ use std::path::{Path, PathBuf};
 
 type Image<'py> = Bound<'py, PyArray3<u8>>;
 
+/// A camera from Python: origin, target, up, vertical field of view in degrees.
+type CameraArgs = ([f64; 3], [f64; 3], [f64; 3], f64);
+
 fn rgba<'py>(py: Python<'py>, r: &Rendered) -> PyResult<Image<'py>> {
     let (w, h) = (r.image.width() as usize, r.image.height() as usize);
     let values = r
@@ -86,7 +89,7 @@ pub fn render_arrays<'py>(
     max_alpha: Option<f64>,
     max_alpha_rel: Option<f64>,
     beta: f64,
-    camera: Option<([f64; 3], [f64; 3], [f64; 3], f64)>,
+    camera: Option<CameraArgs>,
     matcap: String,
     width: i64,
     height: i64,

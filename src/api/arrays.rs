@@ -43,7 +43,7 @@ pub fn mesh_from_arrays(
 
 /// Points from a flat `(n, 3)` array; every coordinate must be finite.
 pub fn points_from_array(values: &[f64], name: &str) -> Result<Vec<DVec3>, InputError> {
-    if values.len() % 3 != 0 {
+    if !values.len().is_multiple_of(3) {
         return Err(InputError::Shape {
             array: name.to_string(),
             len: values.len(),
@@ -74,7 +74,7 @@ fn indices<const N: usize>(
     name: &str,
     count: usize,
 ) -> Result<Vec<[u32; N]>, InputError> {
-    if values.len() % N != 0 {
+    if !values.len().is_multiple_of(N) {
         return Err(InputError::Shape {
             array: name.to_string(),
             len: values.len(),
