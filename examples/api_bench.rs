@@ -45,30 +45,8 @@ fn cpu_seconds() -> f64 {
     }
 }
 
-fn points(mesh: &Mesh, n: usize) -> Vec<DVec3> {
-    let b = mesh.bounds();
-    let diag = b.diagonal();
-    let mut seed = 0x5EEDu64;
-    let mut rnd = move || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let nv = mesh.vertices.len();
-    (0..n)
-        .map(|i| {
-            if i % 2 == 0 {
-                let v = mesh.vertices[(rnd() * nv as f64) as usize % nv].as_dvec3();
-                v + 0.01 * diag * DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)
-            } else {
-                let lo = b.min.as_dvec3() - 0.1 * diag;
-                let hi = b.max.as_dvec3() + 0.1 * diag;
-                lo + (hi - lo) * DVec3::new(rnd(), rnd(), rnd())
-            }
-        })
-        .collect()
-}
+#[path = "common/queries.rs"]
+mod queries;
 
 fn main() {
     let mesh_path = std::env::args()
@@ -96,7 +74,7 @@ fn main() {
             })
             .collect(),
         Err(_) => {
-            let q = points(&mesh, n);
+            let q = queries::queries(&mesh, n);
             let bytes: Vec<u8> = q
                 .iter()
                 .flat_map(|p| p.to_array())
