@@ -102,6 +102,7 @@ def _primitives(
 
 
 def _number(v: Any, name: str) -> Optional[float]:
+    """A real number as float (None stays None); anything else is a ValueError."""
     if v is None:
         return None
     if isinstance(v, bool) or not isinstance(v, numbers.Real):
@@ -110,6 +111,7 @@ def _number(v: Any, name: str) -> Optional[float]:
 
 
 def _threads(threads: Any) -> Optional[int]:
+    """A thread count as int (None: rayon's global pool); the range is checked in Rust."""
     if threads is None:
         return None
     if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
@@ -118,6 +120,8 @@ def _threads(threads: Any) -> Optional[int]:
 
 
 def _alpha_args(alpha, alpha_rel, max_alpha, max_alpha_rel):
+    """The four alpha arguments as floats; an absolute and a relative value exclude each
+    other. Their ranges are checked in Rust, with the command line's messages."""
     if alpha is not None and alpha_rel is not None:
         raise ValueError("give alpha or alpha_rel, not both")
     if max_alpha is not None and max_alpha_rel is not None:
@@ -381,6 +385,7 @@ def render(
 
 
 def _camera(camera: Any):
+    """A camera dict as (origin, target, up, fov) for the extension, or None."""
     if camera is None:
         return None
     if isinstance(camera, Mapping):
@@ -411,6 +416,7 @@ def _camera(camera: Any):
 
 
 def _background(bg: Any):
+    """Three integers 0 to 255."""
     try:
         c = [int(x) for x in bg]
     except (TypeError, ValueError):
