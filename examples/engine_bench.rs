@@ -5,7 +5,7 @@
 //!
 //! Run: `cargo run --release --example engine_bench [-- --csv engine_bench.csv]`
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use rayon::prelude::*;
 use smoothtrace::eval::{self, EvalParams};
 use smoothtrace::mesh::Mesh;
@@ -26,32 +26,9 @@ fn peak_rss_mib() -> f64 {
         .unwrap_or(f64::NAN)
 }
 
-/// Fixed-seed queries: half near the surface (a vertex plus a small offset), half
-/// uniform in the bounding box grown by 10%.
-fn queries(mesh: &Mesh, n: usize) -> Vec<DVec3> {
-    let b = mesh.bounds();
-    let diag = b.diagonal();
-    let mut seed = 0x5EEDu64;
-    let mut rnd = move || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
-    (0..n)
-        .map(|i| {
-            if i % 2 == 0 {
-                let v = mesh.vertices
-                    [(rnd() * mesh.vertices.len() as f64) as usize % mesh.vertices.len()];
-                v.as_dvec3() + 0.01 * diag * DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5)
-            } else {
-                let lo = b.min.as_dvec3() - 0.1 * diag;
-                let hi = b.max.as_dvec3() + 0.1 * diag;
-                lo + (hi - lo) * DVec3::new(rnd(), rnd(), rnd())
-            }
-        })
-        .collect()
-}
+#[path = "common/queries.rs"]
+mod queries;
+use queries::queries;
 
 fn main() {
     let csv = std::env::args().skip_while(|a| a != "--csv").nth(1);

@@ -6,8 +6,10 @@
 //! with valences and weights) -> [`bvh`] -> [`eval`] (smooth distance, nearest) ->
 //! [`render`] (tracer, image loop, with [`camera`] and [`matcap`]), configured by
 //! [`scene`] files. The [`reports`] (bench, sweep, stability) and the exact distance
-//! volumes of [`field`] (SPEC 9) call the same library.
+//! volumes of [`field`] (SPEC 9) call the same library; [`api`] serves callers that hold
+//! their data in memory (the Python bindings in `python/`).
 
+pub mod api;
 pub mod bvh;
 pub mod camera;
 pub mod eval;

@@ -4,6 +4,7 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::DVec3;
+use smoothtrace::api::params::{self, Naming};
 use smoothtrace::eval::{self, Accumulation, EvalParams};
 use smoothtrace::mesh::Mesh;
 use smoothtrace::primitives::{AnySet, PrimitiveKind};
@@ -45,9 +46,7 @@ pub struct QueryArgs {
 }
 
 pub fn run(a: QueryArgs) -> Result<()> {
-    if !(0.0..=1.0).contains(&a.beta) {
-        bail!("--beta must be in [0, 1] (got {})", a.beta);
-    }
+    params::check_beta(Naming::Flag, a.beta)?;
     let mesh = Mesh::load(&a.mesh)?;
     let mut sets = Vec::new();
     for &kind in &a.primitive {
@@ -56,10 +55,16 @@ pub fn run(a: QueryArgs) -> Result<()> {
         }
     }
     let diag = mesh.bounds().diagonal();
-    let alpha = resolve_alpha("alpha", a.alpha, a.alpha_rel, diag)?
+    let alpha = params::resolve_alpha(Naming::Flag, "alpha", a.alpha, a.alpha_rel, diag)?
         .context("give --alpha or --alpha-rel")?;
-    let max_alpha =
-        resolve_alpha("max-alpha", a.max_alpha, a.max_alpha_rel, diag)?.unwrap_or(alpha);
+    let max_alpha = params::resolve_alpha(
+        Naming::Flag,
+        "max_alpha",
+        a.max_alpha,
+        a.max_alpha_rel,
+        diag,
+    )?
+    .unwrap_or(alpha);
     let mut params = EvalParams::new(alpha, max_alpha, a.beta);
     if a.naive {
         params.accumulation = Accumulation::Naive;
@@ -114,26 +119,6 @@ pub fn run(a: QueryArgs) -> Result<()> {
         );
     }
     Ok(())
-}
-
-fn resolve_alpha(name: &str, abs: Option<f64>, rel: Option<f64>, diag: f64) -> Result<Option<f64>> {
-    let v = match (abs, rel) {
-        (Some(a), _) => a,
-        (None, Some(r)) => {
-            if !(r > 0.0 && r.is_finite()) {
-                bail!("--{name}-rel must be a positive number (got {r})");
-            }
-            if diag.is_nan() || diag <= 0.0 {
-                bail!("--{name}-rel needs a mesh with a non-zero bounding box; give --{name}");
-            }
-            r / diag
-        }
-        (None, None) => return Ok(None),
-    };
-    if !(v > 0.0 && v.is_finite()) {
-        bail!("--{name} must be a positive number (got {v})");
-    }
-    Ok(Some(v))
 }
 
 fn read_points(path: Option<&PathBuf>) -> Result<Vec<DVec3>> {

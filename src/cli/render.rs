@@ -4,6 +4,7 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use smoothtrace::api::params::{Naming, SceneOverrides};
 use smoothtrace::render::TracerOptions;
 use smoothtrace::render::build::BuiltScene;
 use smoothtrace::render::image::{ImageStats, Rendered};
@@ -64,45 +65,14 @@ pub fn load_scene(
     threads: Option<i64>,
 ) -> Result<Scene> {
     let mut scene = Scene::load(path)?;
-    let size = |name: &str, v: i64| -> Result<u32> {
-        if !(1..=smoothtrace::scene::MAX_IMAGE_SIZE as i64).contains(&v) {
-            bail!(
-                "--{name} must be in 1..={} (got {v})",
-                smoothtrace::scene::MAX_IMAGE_SIZE
-            );
-        }
-        Ok(v as u32)
-    };
-    if let Some(w) = width {
-        scene.image.width = size("width", w)?;
+    SceneOverrides {
+        width,
+        height,
+        beta,
+        alpha,
+        threads,
     }
-    if let Some(h) = height {
-        scene.image.height = size("height", h)?;
-    }
-    if let Some(b) = beta {
-        if !(0.0..=1.0).contains(&b) {
-            bail!("--beta must be in [0, 1] (got {b})");
-        }
-        scene.render.beta = b;
-    }
-    if let Some(a) = alpha {
-        if !(a.value() > 0.0 && a.value().is_finite()) {
-            bail!(
-                "--{} must be a positive number (got {})",
-                a.key().replace('_', "-"),
-                a.value()
-            );
-        }
-        for o in &mut scene.objects {
-            o.alpha = a;
-        }
-    }
-    if let Some(t) = threads {
-        if !(0..=1024).contains(&t) {
-            bail!("--threads must be in 0..=1024 (got {t})");
-        }
-        scene.render.threads = t as usize;
-    }
+    .apply(&mut scene, Naming::Flag)?;
     scene.validate()?;
     Ok(scene)
 }

@@ -1,5 +1,7 @@
 //! A scene file's whole path to an image: build the objects, make the tracer, render,
 //! all inside a thread pool of the scene's size (`[render] threads`, 0 = all cores).
+//! [`render_built`] renders objects built some other way (the in-memory arrays of
+//! [`crate::api`]) the same way.
 
 use super::build::{BuildError, BuiltScene, build_scene};
 use super::image::{Rendered, render};
@@ -19,15 +21,27 @@ pub fn render_scene(
         .map_err(|e| BuildError::Threads(e.to_string()))?;
     pool.install(|| {
         let built = build_scene(scene)?;
-        let opts = options(TracerOptions::new(built.epsilon, scene.render.max_steps));
-        let tracer = Tracer::new(&built.objects, opts);
-        let rendered = render(
-            &tracer,
-            &built.camera,
-            &built.shaders,
+        let rendered = render_built(
+            &built,
+            scene.render.max_steps,
             scene.image.background,
+            options,
             progress,
         );
         Ok((built, rendered))
     })
+}
+
+/// Renders built objects with the tracer defaults for `built.epsilon` and `max_steps`
+/// (adjusted by `options`), in the current rayon pool; misses get `background`.
+pub fn render_built(
+    built: &BuiltScene,
+    max_steps: u32,
+    background: [u8; 3],
+    options: impl Fn(TracerOptions) -> TracerOptions,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Rendered {
+    let opts = options(TracerOptions::new(built.epsilon, max_steps));
+    let tracer = Tracer::new(&built.objects, opts);
+    render(&tracer, &built.camera, &built.shaders, background, progress)
 }
