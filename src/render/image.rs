@@ -147,10 +147,11 @@ pub fn render(
                 row_stats.tally(&r);
                 if let Some(hit) = r.hit {
                     let n = camera.to_camera_space(hit.normal);
-                    colours[px as usize] = shaders
+                    let shaded = shaders
                         .get(hit.object)
                         .map(|m| m.shade(n))
                         .unwrap_or([255, 0, 255]);
+                    colours[px as usize] = super::albedo::shade_hit(tracer.objects(), &hit, shaded);
                     row_depth[px as usize] = hit.t as f32;
                 }
             }

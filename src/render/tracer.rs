@@ -156,6 +156,11 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    /// The objects traced (for shading a hit).
+    pub fn objects(&self) -> &'a [TraceObject] {
+        self.objects
+    }
+
     pub fn options(&self) -> &TracerOptions {
         &self.options
     }

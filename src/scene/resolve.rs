@@ -19,6 +19,8 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+mod lidar;
+
 /// Parses `text` (the contents of `path`) into an unvalidated scene.
 pub(super) fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
     let raw: RawScene = toml::from_str(text).map_err(|e| error::from_toml(path, text, &e))?;
@@ -251,6 +253,19 @@ impl Resolver<'_> {
             None => Transform::IDENTITY,
             Some(t) => self.transform(&name, t)?,
         };
+        let las = self.lidar(
+            &name,
+            lidar::RawLidar {
+                classes: raw.classes,
+                exclude_classes: raw.exclude_classes,
+                returns: raw.returns,
+                crop: raw.crop,
+                thin: raw.thin,
+                origin: raw.origin,
+                color_by: raw.color_by,
+                colormap: raw.colormap,
+            },
+        )?;
         Ok(Object {
             geometry,
             primitives,
@@ -258,6 +273,7 @@ impl Resolver<'_> {
             max_alpha,
             transform,
             matcap,
+            las,
         })
     }
 
