@@ -266,6 +266,17 @@ pub fn load_mesh(path: &Path, kinds: &[PrimitiveKind]) -> Result<(Mesh, DVec3), 
     Ok((cloud.mesh, cloud.origin))
 }
 
+/// A scene object's mesh file: a lidar file read with the object's `options` (filters,
+/// origin), any other file through [`Mesh::load`]. For callers that need the points
+/// only (the renderer reads [`read`] itself to keep the colours and counts).
+pub fn load_scene_mesh(path: &Path, options: &LasOptions) -> Result<Mesh, MeshError> {
+    if is_lidar_path(path) {
+        Ok(read(path, options)?.mesh)
+    } else {
+        Mesh::load(path)
+    }
+}
+
 /// Keeps the items whose flag is set, in order.
 fn retain<T>(items: &mut Vec<T>, keep: &[bool]) {
     let mut flags = keep.iter();
