@@ -567,7 +567,13 @@ fn scene_keys_resolve_and_bad_values_are_named() {
         ),
         (
             "color_by = \"intensity\"\ncolormap = \"jet\"",
-            &["s.toml:14:", "unknown colormap \"jet\"", "viridis"],
+            &[
+                "s.toml:14:",
+                "object[0].colormap",
+                "unknown colormap",
+                "\"jet\"",
+                "viridis",
+            ],
         ),
         (
             "color_by = \"rgb\"\ncolormap = \"magma\"",

@@ -202,6 +202,7 @@ impl Resolver<'_> {
         let name = format!("object[{i}]");
         let span = raw.span();
         let raw = raw.into_inner();
+        let las = self.lidar(&name, &raw)?;
         let geometry = match (raw.mesh, raw.generator) {
             (Some(_), Some(g)) => {
                 return Err(self.invalid(
@@ -253,19 +254,6 @@ impl Resolver<'_> {
             None => Transform::IDENTITY,
             Some(t) => self.transform(&name, t)?,
         };
-        let las = self.lidar(
-            &name,
-            lidar::RawLidar {
-                classes: raw.classes,
-                exclude_classes: raw.exclude_classes,
-                returns: raw.returns,
-                crop: raw.crop,
-                thin: raw.thin,
-                origin: raw.origin,
-                color_by: raw.color_by,
-                colormap: raw.colormap,
-            },
-        )?;
         Ok(Object {
             geometry,
             primitives,

@@ -5,27 +5,15 @@
 //! object is a lidar file at all is checked by the validator.
 
 use super::super::error::SceneError;
-use super::super::raw::{RawCrop, RawThin};
+use super::super::raw::{RawCrop, RawObject, RawThin};
 use super::Resolver;
 use crate::colour::Colormap;
 use crate::las::{ColorBy, LasFilters, LasOptions, NOISE_CLASSES, Returns, Thin};
 use glam::DVec3;
 use toml::Spanned;
 
-/// The lidar keys as written.
-pub(super) struct RawLidar {
-    pub classes: Option<Spanned<Vec<i64>>>,
-    pub exclude_classes: Option<Spanned<Vec<i64>>>,
-    pub returns: Option<Spanned<String>>,
-    pub crop: Option<Spanned<RawCrop>>,
-    pub thin: Option<Spanned<RawThin>>,
-    pub origin: Option<Spanned<[f64; 3]>>,
-    pub color_by: Option<Spanned<String>>,
-    pub colormap: Option<Spanned<String>>,
-}
-
 impl Resolver<'_> {
-    pub(super) fn lidar(&mut self, name: &str, raw: RawLidar) -> Result<LasOptions, SceneError> {
+    pub(super) fn lidar(&mut self, name: &str, raw: &RawObject) -> Result<LasOptions, SceneError> {
         let classes = match &raw.classes {
             None => None,
             Some(v) => Some(self.class_list(name, "classes", v)?),
@@ -38,18 +26,9 @@ impl Resolver<'_> {
         };
         let returns = match &raw.returns {
             None => Returns::All,
-            Some(v) => {
-                let key = format!("{name}.returns");
-                let r = Returns::from_name(v.get_ref()).ok_or_else(|| {
-                    self.invalid(
-                        v.span(),
-                        &key,
-                        format!("{key} must be {} (got \"{}\")", Returns::NAMES, v.get_ref()),
-                    )
-                })?;
-                self.record(&key, v.span(), &r);
-                r
-            }
+            Some(v) => self.named(name, "returns", v, Returns::from_name, || {
+                format!("must be {}", Returns::NAMES)
+            })?,
         };
         let crop = match &raw.crop {
             None => None,
@@ -77,37 +56,18 @@ impl Resolver<'_> {
         };
         let color_by = match &raw.color_by {
             None => None,
-            Some(v) => {
-                let key = format!("{name}.color_by");
-                let c = ColorBy::from_name(v.get_ref()).ok_or_else(|| {
-                    self.invalid(
-                        v.span(),
-                        &key,
-                        format!("{key} must be {} (got \"{}\")", ColorBy::NAMES, v.get_ref()),
-                    )
-                })?;
-                self.record(&key, v.span(), &Some(c));
-                Some(c)
-            }
+            Some(v) => Some(self.named(name, "color_by", v, ColorBy::from_name, || {
+                format!("must be {}", ColorBy::NAMES)
+            })?),
         };
         let colormap = match &raw.colormap {
             None => None,
-            Some(v) => {
-                let key = format!("{name}.colormap");
-                let c = Colormap::from_name(v.get_ref()).ok_or_else(|| {
-                    self.invalid(
-                        v.span(),
-                        &key,
-                        format!(
-                            "{key}: unknown colormap \"{}\" (expected one of {})",
-                            v.get_ref(),
-                            Colormap::names()
-                        ),
-                    )
-                })?;
-                self.record(&key, v.span(), &Some(c));
-                Some(c)
-            }
+            Some(v) => Some(self.named(name, "colormap", v, Colormap::from_name, || {
+                format!(
+                    "names an unknown colormap; expected one of {}",
+                    Colormap::names()
+                )
+            })?),
         };
         Ok(LasOptions {
             filters: LasFilters {
@@ -121,6 +81,32 @@ impl Resolver<'_> {
             colormap,
             origin,
         })
+    }
+
+    /// A name looked up by `parse`, recorded under `name.key` (as an `Option`, the way
+    /// the validator sees `color_by` and `colormap`; `returns` is recorded bare).
+    fn named<T: std::fmt::Debug + Copy>(
+        &mut self,
+        name: &str,
+        key: &str,
+        v: &Spanned<String>,
+        parse: impl Fn(&str) -> Option<T>,
+        expected: impl Fn() -> String,
+    ) -> Result<T, SceneError> {
+        let key = format!("{name}.{key}");
+        let Some(value) = parse(v.get_ref()) else {
+            return Err(self.invalid(
+                v.span(),
+                &key,
+                format!("{key} {} (got \"{}\")", expected(), v.get_ref()),
+            ));
+        };
+        if key.ends_with(".returns") {
+            self.record(&key, v.span(), &value);
+        } else {
+            self.record(&key, v.span(), &Some(value));
+        }
+        Ok(value)
     }
 
     /// A list of ASPRS classes (0..=255), recorded under `name.key`.
