@@ -717,3 +717,78 @@ fn query_takes_points_in_file_coordinates() {
         "{e}"
     );
 }
+
+#[test]
+fn the_small_files_read_like_their_raw_records() {
+    for name in [
+        "1.2-with-color.las",
+        "100-points.las",
+        "extrabytes.las",
+        "test1_4.las",
+        "simple.laz",
+    ] {
+        let Some(path) = data_file(&format!("las/{name}")) else {
+            return;
+        };
+        let (header, records) = raw_records(&path);
+        let cloud = las::read(&path, &keep_all()).unwrap();
+        assert_eq!(cloud.header_points, header.number_of_points(), "{name}");
+        assert_eq!(cloud.mesh.vertices.len(), records.len(), "{name}");
+        assert_eq!(cloud.bounds, bounds_of(&records), "{name}");
+        assert_eq!(
+            cloud.point_format,
+            header.point_format().to_u8().unwrap(),
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn noise_is_dropped_by_default_and_kept_on_request() {
+    // A file written here: classes 1, 2, 7, 18 at known places.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("noise.las");
+    let classes = [1u8, 2, 7, 18, 2, 7];
+    {
+        let mut builder = ::las::Builder::from((1, 4));
+        builder.point_format = ::las::point::Format::new(6).unwrap();
+        let mut w = ::las::Writer::from_path(&path, builder.into_header().unwrap()).unwrap();
+        for (i, &c) in classes.iter().enumerate() {
+            w.write_point(::las::Point {
+                x: 1000.0 + i as f64,
+                y: 2000.0,
+                z: 10.0 * i as f64,
+                classification: ::las::point::Classification::new(c).unwrap(),
+                return_number: 1,
+                number_of_returns: 1,
+                gps_time: Some(0.0),
+                ..Default::default()
+            })
+            .unwrap();
+        }
+        w.close().unwrap();
+    }
+    let kept = |options: &LasOptions| {
+        let c = las::read(&path, options).unwrap();
+        c.mesh
+            .vertices
+            .iter()
+            .map(|v| ((v.as_dvec3() + c.origin).x - 1000.0).round() as usize)
+            .collect::<Vec<_>>()
+    };
+    let noise_free: Vec<usize> = (0..classes.len())
+        .filter(|&i| ![7, 18].contains(&classes[i]))
+        .collect();
+    assert_eq!(kept(&LasOptions::default()), noise_free);
+    assert_eq!(kept(&keep_all()), (0..classes.len()).collect::<Vec<_>>());
+    // Naming classes replaces the default exclusion (as a scene does).
+    let only_noise = LasOptions {
+        filters: LasFilters {
+            classes: Some(vec![7]),
+            exclude_classes: Vec::new(),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    assert_eq!(kept(&only_noise), [2, 5]);
+}
