@@ -12,9 +12,11 @@
 pub mod api;
 pub mod bvh;
 pub mod camera;
+pub mod colour;
 pub mod eval;
 pub mod field;
 pub mod geometry;
+pub mod las;
 pub mod matcap;
 pub mod mesh;
 pub mod primitives;

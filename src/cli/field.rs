@@ -5,7 +5,6 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use smoothtrace::field::{self, Domains, FieldOptions, Grid, Method};
-use smoothtrace::mesh::Mesh;
 use smoothtrace::primitives::PrimitiveKind;
 use std::path::PathBuf;
 
@@ -22,7 +21,8 @@ pub enum MethodArg {
 
 #[derive(Args, Debug)]
 pub struct FieldArgs {
-    /// Mesh file (.obj, .ply, .stl).
+    /// Mesh file (.obj, .ply, .stl), or a lidar point cloud (.las, .laz; --bounds in its
+    /// file coordinates).
     mesh: PathBuf,
     /// Primitive set: points (all vertices), edges (segments, else triangle edges) or
     /// triangles.
@@ -75,9 +75,21 @@ pub struct FieldArgs {
 }
 
 pub fn run(a: FieldArgs) -> Result<()> {
-    let mesh = Mesh::load(&a.mesh)?;
+    let (mesh, origin) = smoothtrace::las::load_mesh(&a.mesh, &[a.primitive])?;
+    if origin != DVec3::ZERO {
+        eprintln!(
+            "{}: lidar points recentred: grid coordinates are file coordinates minus [{}, {}, {}]",
+            a.mesh.display(),
+            origin.x,
+            origin.y,
+            origin.z
+        );
+    }
     let (min, max) = match &a.bounds {
-        Some(b) => (DVec3::new(b[0], b[1], b[2]), DVec3::new(b[3], b[4], b[5])),
+        Some(b) => (
+            DVec3::new(b[0], b[1], b[2]) - origin,
+            DVec3::new(b[3], b[4], b[5]) - origin,
+        ),
         None => Grid::default_bounds(mesh.bounds())
             .context("cannot choose default bounds; give --bounds")?,
     };

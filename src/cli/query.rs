@@ -6,14 +6,14 @@ use clap::Args;
 use glam::DVec3;
 use smoothtrace::api::params::{self, Naming};
 use smoothtrace::eval::{self, Accumulation, EvalParams};
-use smoothtrace::mesh::Mesh;
 use smoothtrace::primitives::{AnySet, PrimitiveKind};
 use std::io::{BufRead, BufWriter, Write};
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct QueryArgs {
-    /// Mesh file (.obj, .ply, .stl).
+    /// Mesh file (.obj, .ply, .stl), or a lidar point cloud (.las, .laz; query points in
+    /// its file coordinates).
     mesh: PathBuf,
     /// Primitive set(s) to use; repeat or comma-separate to sum several.
     #[arg(long, short, value_delimiter = ',', required = true)]
@@ -47,7 +47,8 @@ pub struct QueryArgs {
 
 pub fn run(a: QueryArgs) -> Result<()> {
     params::check_beta(Naming::Flag, a.beta)?;
-    let mesh = Mesh::load(&a.mesh)?;
+    // Lidar coordinates are recentred on load; query points stay in file coordinates.
+    let (mesh, origin) = smoothtrace::las::load_mesh(&a.mesh, &a.primitive)?;
     let mut sets = Vec::new();
     for &kind in &a.primitive {
         if !sets.iter().any(|s: &AnySet| s.kind() == kind) {
@@ -84,7 +85,10 @@ pub fn run(a: QueryArgs) -> Result<()> {
         a.beta,
         if a.naive { "naive" } else { "stable" },
     );
-    let queries = read_points(a.points.as_ref())?;
+    let queries: Vec<DVec3> = read_points(a.points.as_ref())?
+        .into_iter()
+        .map(|x| x - origin)
+        .collect();
     let set_refs: Vec<&AnySet> = sets.iter().collect();
     let results: Vec<String> = {
         use rayon::prelude::*;

@@ -8,6 +8,7 @@
 
 pub mod accumulate;
 pub mod brute;
+pub mod colour;
 pub mod nearest;
 pub mod smooth;
 

@@ -11,7 +11,7 @@ pub enum MeshError {
         #[source]
         source: std::io::Error,
     },
-    #[error("{}: unknown mesh extension '{extension}' (expected .obj, .ply or .stl)", path.display())]
+    #[error("{}: unknown mesh extension '{extension}' (expected .obj, .ply, .stl, .las or .laz)", path.display())]
     UnknownExtension { path: PathBuf, extension: String },
     #[error("{}:{line}: {message}", path.display())]
     Parse {

@@ -85,6 +85,8 @@ impl Aabb {
 
 impl Mesh {
     /// Reads a mesh, choosing the reader by extension (`.obj`, `.ply`, `.stl`, any case).
+    /// Lidar files (`.las`, `.laz`) give their points with the default filters (noise
+    /// classes dropped), recentred on the header's box centre ([`crate::las`]).
     ///
     /// Errors name the file and what was wrong; a mesh with no vertices is an error.
     pub fn load(path: &Path) -> Result<Mesh, MeshError> {
@@ -97,6 +99,7 @@ impl Mesh {
             "obj" => obj::read_obj(path)?,
             "ply" => ply::read_ply(path)?,
             "stl" => stl::read_stl(path)?,
+            "las" | "laz" => crate::las::read(path, &Default::default())?.mesh,
             _ => {
                 return Err(MeshError::UnknownExtension {
                     path: path.to_path_buf(),

@@ -5,6 +5,7 @@
 
 use super::object::TraceObject;
 use crate::camera::{Camera, CameraError};
+use crate::colour::{ObjectColours, SetColours};
 use crate::eval::EvalParams;
 use crate::matcap::{MatCap, MatCapError};
 use crate::mesh::{Aabb, Mesh, MeshError};
@@ -90,12 +91,20 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
     let mut loaded_matcaps: Vec<(crate::matcap::MatCapSpec, MatCap)> = Vec::new();
     for (k, obj) in scene.objects.iter().enumerate() {
         let t = Instant::now();
+        let mesh_error = |source| BuildError::Mesh {
+            scene: name.clone(),
+            object: k,
+            source,
+        };
+        let mut vertex_colours = None;
         let mut mesh = match &obj.geometry {
-            Geometry::Mesh(path) => Mesh::load(path).map_err(|source| BuildError::Mesh {
-                scene: name.clone(),
-                object: k,
-                source,
-            })?,
+            Geometry::Mesh(path) if crate::las::is_lidar_path(path) => {
+                let cloud = crate::las::read(path, &obj.las).map_err(mesh_error)?;
+                steps.extend(lidar_steps(k, &cloud, t.elapsed().as_secs_f64()));
+                vertex_colours = cloud.colours;
+                cloud.mesh
+            }
+            Geometry::Mesh(path) => Mesh::load(path).map_err(mesh_error)?,
             Geometry::Generator(g) => g.build().map_err(|source| BuildError::Generator {
                 scene: name.clone(),
                 object: k,
@@ -161,6 +170,21 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
             });
             sets.push(set);
         }
+        let colours = vertex_colours.map(|vc| {
+            let t = Instant::now();
+            let c = ObjectColours {
+                sets: sets
+                    .iter()
+                    .map(|s| SetColours::build(s, &mesh, &vc))
+                    .collect(),
+            };
+            steps.push(BuildStep {
+                object: k,
+                what: "colours per primitive and per BVH node".to_string(),
+                seconds: t.elapsed().as_secs_f64(),
+            });
+            c
+        });
         drop(mesh);
         let params = EvalParams {
             accumulation: scene.render.evaluation,
@@ -175,7 +199,9 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
             ),
             seconds: 0.0,
         });
-        objects.push(TraceObject::new(sets, params));
+        let mut object = TraceObject::new(sets, params);
+        object.colours = colours;
+        objects.push(object);
         // Each distinct MatCap is built or loaded once.
         let shader = match loaded_matcaps.iter().find(|(s, _)| *s == obj.matcap) {
             Some((_, m)) => m.clone(),
@@ -210,4 +236,35 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
         bounds,
         steps,
     })
+}
+
+/// `--verbose` lines of a lidar file: what was read, each filter's count, the origin.
+fn lidar_steps(k: usize, cloud: &crate::las::LasCloud, seconds: f64) -> Vec<BuildStep> {
+    let step = |what: String, seconds: f64| BuildStep {
+        object: k,
+        what,
+        seconds,
+    };
+    let [lo, hi] = cloud.bounds;
+    let mut out = vec![step(
+        format!(
+            "lidar {}: LAS {} point format {}, {} points in the header",
+            cloud.mesh.name, cloud.version, cloud.point_format, cloud.header_points
+        ),
+        seconds,
+    )];
+    out.extend(
+        cloud
+            .counts
+            .iter()
+            .map(|c| step(format!("filter {}: {} points kept", c.filter, c.kept), 0.0)),
+    );
+    out.push(step(
+        format!(
+            "origin [{}, {}, {}] (scene = file - origin); kept points span [{}, {}, {}] .. [{}, {}, {}] in file coordinates",
+            cloud.origin.x, cloud.origin.y, cloud.origin.z, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+        ),
+        0.0,
+    ));
+    out
 }

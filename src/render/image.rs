@@ -200,10 +200,11 @@ pub fn render(
                     if let Some(hit) = r.hit {
                         let i = ((py - tile.y0) * tile.w + (px - tile.x0)) as usize;
                         let n = camera.to_camera_space(hit.normal);
-                        colours[i] = shaders
+                        let shaded = shaders
                             .get(hit.object)
                             .map(|m| m.shade(n))
                             .unwrap_or([255, 0, 255]);
+                        colours[i] = super::albedo::shade_hit(tracer.objects(), &hit, shaded);
                         tile_depth[i] = hit.t as f32;
                     }
                 },

@@ -6,6 +6,7 @@ pub mod tracer;
 
 pub use object::TraceObject;
 pub use tracer::{Backtrack, Hit, RayResult, RayStats, Tracer, TracerOptions};
+pub mod albedo;
 pub mod build;
 pub mod image;
 pub mod pipeline;

@@ -1,6 +1,7 @@
 //! A traceable object: one or more primitive sets summed into one smooth distance
 //! (SPEC 2), with its evaluation parameters and the bound of where its surface can be.
 
+use crate::colour::ObjectColours;
 use crate::eval::{self, EvalParams, Sample};
 use crate::mesh::Aabb;
 use crate::primitives::{AnySet, WeightScale};
@@ -12,6 +13,9 @@ pub struct TraceObject {
     pub params: EvalParams,
     /// Union of the sets' bounding boxes.
     pub bounds: Aabb,
+    /// Colours from the data, one [`crate::colour::SetColours`] per set; `None` shades
+    /// with the MatCap alone.
+    pub colours: Option<ObjectColours>,
 }
 
 impl TraceObject {
@@ -21,6 +25,7 @@ impl TraceObject {
             sets,
             params,
             bounds,
+            colours: None,
         }
     }
 

@@ -182,6 +182,11 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    /// The objects traced (for shading a hit).
+    pub fn objects(&self) -> &'a [TraceObject] {
+        self.objects
+    }
+
     pub fn options(&self) -> &TracerOptions {
         &self.options
     }

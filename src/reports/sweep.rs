@@ -20,7 +20,7 @@ use super::compare::{DepthDiff, compare_depths};
 use super::table::{Cell, Table};
 use super::{Progress, quantile, render_objects};
 use crate::eval::{self, Accumulation, EvalParams};
-use crate::mesh::{Aabb, Mesh};
+use crate::mesh::Aabb;
 use crate::primitives::AnySet;
 use crate::render::TracerOptions;
 use crate::render::build::{BuildError, BuiltScene, build_scene};
@@ -400,7 +400,9 @@ fn grid_object(scene: &Scene) -> Result<(Vec<AnySet>, f64, f64), SweepError> {
     };
     let obj = &scene.objects[0];
     let mut mesh = match &obj.geometry {
-        Geometry::Mesh(p) => Mesh::load(p).map_err(|e| fail(e.to_string()))?,
+        Geometry::Mesh(p) => {
+            crate::las::load_scene_mesh(p, &obj.las).map_err(|e| fail(e.to_string()))?
+        }
         Geometry::Generator(g) => g.build().map_err(|e| fail(e.to_string()))?,
     };
     if !obj.transform.is_identity() {

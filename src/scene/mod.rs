@@ -26,6 +26,7 @@ pub use error::{Location, SceneError};
 pub use transform::Transform;
 
 use crate::camera::{Camera, CameraError};
+pub use crate::las::LasOptions;
 use crate::primitives::PrimitiveKind;
 use crate::procedural::Generator;
 use glam::DVec3;
@@ -135,6 +136,9 @@ pub struct Object {
     pub max_alpha: Option<AlphaSpec>,
     pub transform: Transform,
     pub matcap: MatCapSpec,
+    /// Lidar filters, origin and colour (`classes`, `crop`, `color_by`, ...); only for
+    /// `.las` / `.laz` meshes, the default everywhere else.
+    pub las: LasOptions,
 }
 
 impl Object {

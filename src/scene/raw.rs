@@ -60,6 +60,31 @@ pub(super) struct RawObject {
     pub max_alpha_rel: Option<Spanned<f64>>,
     pub matcap: Option<Spanned<String>>,
     pub transform: Option<RawTransform>,
+    // Lidar (.las / .laz) filters and colour; checked when resolving.
+    pub classes: Option<Spanned<Vec<i64>>>,
+    pub exclude_classes: Option<Spanned<Vec<i64>>>,
+    pub returns: Option<Spanned<String>>,
+    pub crop: Option<Spanned<RawCrop>>,
+    pub thin: Option<Spanned<RawThin>>,
+    pub origin: Option<Spanned<[f64; 3]>>,
+    pub color_by: Option<Spanned<String>>,
+    pub colormap: Option<Spanned<String>>,
+}
+
+/// `crop = { min = [x, y, z], max = [x, y, z] }` in file coordinates.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawCrop {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+/// `thin = { voxel = size }` or `thin = { every = k }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawThin {
+    pub voxel: Option<f64>,
+    pub every: Option<i64>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -19,6 +19,8 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+mod lidar;
+
 /// Parses `text` (the contents of `path`) into an unvalidated scene.
 pub(super) fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
     let raw: RawScene = toml::from_str(text).map_err(|e| error::from_toml(path, text, &e))?;
@@ -200,6 +202,7 @@ impl Resolver<'_> {
         let name = format!("object[{i}]");
         let span = raw.span();
         let raw = raw.into_inner();
+        let las = self.lidar(&name, &raw)?;
         let geometry = match (raw.mesh, raw.generator) {
             (Some(_), Some(g)) => {
                 return Err(self.invalid(
@@ -258,6 +261,7 @@ impl Resolver<'_> {
             max_alpha,
             transform,
             matcap,
+            las,
         })
     }
 

@@ -6,6 +6,7 @@
 use super::{AlphaSpec, Epsilon, Geometry, MAX_IMAGE_SIZE, Scene, SceneError};
 use crate::camera::{CameraError, check_view};
 use crate::matcap::{MatCapSpec, builtin_names};
+use crate::primitives::PrimitiveKind;
 use glam::DVec3;
 use std::fmt::Debug;
 use std::path::Path;
@@ -189,6 +190,68 @@ impl Checker<'_> {
             }
             self.transform(&name, &o.transform)?;
             self.matcap(&name, &o.matcap)?;
+            self.lidar(&name, o)?;
+        }
+        Ok(())
+    }
+
+    /// Lidar objects give points only; the lidar keys need a lidar file; a colormap
+    /// needs a scalar `color_by`.
+    fn lidar(&self, name: &str, o: &super::Object) -> Result<(), SceneError> {
+        let las = &o.las;
+        let is_lidar = matches!(&o.geometry, Geometry::Mesh(p) if crate::las::is_lidar_path(p));
+        if is_lidar {
+            if let Some(kind) = o.primitives.iter().find(|k| **k != PrimitiveKind::Points) {
+                let field = format!("{name}.primitives");
+                return Err(self.fail(
+                    &field,
+                    &o.primitives,
+                    format!(
+                        "{field}: a .las/.laz file holds points only, so it cannot give {kind};                          use primitives = \"points\""
+                    ),
+                ));
+            }
+            if let Some(map) = las.colormap
+                && !las.color_by.is_some_and(|c| c.is_scalar())
+            {
+                let field = format!("{name}.colormap");
+                return Err(self.fail(
+                    &field,
+                    &Some(map),
+                    format!(
+                        "{field} colours a scalar: it needs color_by = \"intensity\" or                          \"elevation\" (got color_by = {})",
+                        las.color_by
+                            .map_or("none".to_string(), |c| format!("\"{}\"", c.name()))
+                    ),
+                ));
+            }
+            return Ok(());
+        }
+        let d = crate::las::LasOptions::default();
+        let f = &las.filters;
+        let given: [(&str, &dyn Debug, bool); 8] = [
+            ("classes", &f.classes, f.classes != d.filters.classes),
+            (
+                "exclude_classes",
+                &f.exclude_classes,
+                f.exclude_classes != d.filters.exclude_classes,
+            ),
+            ("returns", &f.returns, f.returns != d.filters.returns),
+            ("crop", &f.crop, f.crop != d.filters.crop),
+            ("thin", &f.thin, f.thin != d.filters.thin),
+            ("origin", &las.origin, las.origin.is_some()),
+            ("color_by", &las.color_by, las.color_by.is_some()),
+            ("colormap", &las.colormap, las.colormap.is_some()),
+        ];
+        if let Some((key, value, _)) = given.iter().find(|g| g.2) {
+            let field = format!("{name}.{key}");
+            return Err(self.fail(
+                &field,
+                *value,
+                format!(
+                    "{field} applies to lidar point clouds only (mesh = \"....las\" or                      \".laz\"); this object is not one"
+                ),
+            ));
         }
         Ok(())
     }
