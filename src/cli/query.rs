@@ -1,14 +1,23 @@
 //! `smoothtrace query`: smooth distance, gradient, exact distance and leaves visited at
 //! points read from a file or standard input.
 
+use super::console::{Stdout, note};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::DVec3;
 use smoothtrace::eval::{self, Accumulation, EvalParams};
+use smoothtrace::limits;
 use smoothtrace::mesh::Mesh;
 use smoothtrace::primitives::{AnySet, PrimitiveKind};
-use std::io::{BufRead, BufWriter, Write};
-use std::path::PathBuf;
+use std::io::{BufRead, Read};
+use std::path::{Path, PathBuf};
+
+/// Longest accepted line of query points.
+const MAX_LINE_BYTES: u64 = 64 * 1024;
+
+/// Most query points per run: the points and their result lines are held in memory
+/// (about 150 bytes each, 1.5 GB at this limit).
+const MAX_QUERY_POINTS: usize = 10_000_000;
 
 #[derive(Args, Debug)]
 pub struct QueryArgs {
@@ -48,6 +57,8 @@ pub fn run(a: QueryArgs) -> Result<()> {
     if !(0.0..=1.0).contains(&a.beta) {
         bail!("--beta must be in [0, 1] (got {})", a.beta);
     }
+    // Before any work: a closed standard output fails here.
+    let mut out = Stdout::open()?;
     let mesh = Mesh::load(&a.mesh)?;
     let mut sets = Vec::new();
     for &kind in &a.primitive {
@@ -56,16 +67,16 @@ pub fn run(a: QueryArgs) -> Result<()> {
         }
     }
     let diag = mesh.bounds().diagonal();
-    let alpha = resolve_alpha("alpha", a.alpha, a.alpha_rel, diag)?
+    let alpha = resolve_alpha("alpha", a.alpha, a.alpha_rel, diag, &a.mesh)?
         .context("give --alpha or --alpha-rel")?;
     let max_alpha =
-        resolve_alpha("max-alpha", a.max_alpha, a.max_alpha_rel, diag)?.unwrap_or(alpha);
+        resolve_alpha("max-alpha", a.max_alpha, a.max_alpha_rel, diag, &a.mesh)?.unwrap_or(alpha);
     let mut params = EvalParams::new(alpha, max_alpha, a.beta);
     if a.naive {
         params.accumulation = Accumulation::Naive;
     }
     let n: usize = sets.iter().map(|s| s.len()).sum();
-    eprintln!(
+    note!(
         "{}: {} {} ({} primitives), diagonal {diag}, alpha {alpha} (alpha * diagonal = {}), max_alpha {max_alpha}, beta {}, {} accumulation",
         a.mesh.display(),
         mesh.name,
@@ -101,14 +112,13 @@ pub fn run(a: QueryArgs) -> Result<()> {
             .collect()
     };
     let underflows = results.iter().filter(|l| l.starts_with("inf")).count();
-    let stdout = std::io::stdout();
-    let mut out = BufWriter::new(stdout.lock());
     for line in &results {
-        writeln!(out, "{line}")?;
+        out.write(line)?;
+        out.write("\n")?;
     }
-    out.flush()?;
-    if underflows > 0 {
-        eprintln!(
+    out.finish()?;
+    if a.naive && underflows > 0 {
+        note!(
             "warning: the naive sum underflowed (s = inf) at {underflows} of {} queries; the stable evaluation (without --naive) does not",
             results.len()
         );
@@ -116,7 +126,15 @@ pub fn run(a: QueryArgs) -> Result<()> {
     Ok(())
 }
 
-fn resolve_alpha(name: &str, abs: Option<f64>, rel: Option<f64>, diag: f64) -> Result<Option<f64>> {
+/// An absolute alpha, or a relative one divided by the mesh's diagonal, checked against
+/// [`limits::alpha_problem`].
+fn resolve_alpha(
+    name: &str,
+    abs: Option<f64>,
+    rel: Option<f64>,
+    diag: f64,
+    mesh: &Path,
+) -> Result<Option<f64>> {
     let v = match (abs, rel) {
         (Some(a), _) => a,
         (None, Some(r)) => {
@@ -124,32 +142,71 @@ fn resolve_alpha(name: &str, abs: Option<f64>, rel: Option<f64>, diag: f64) -> R
                 bail!("--{name}-rel must be a positive number (got {r})");
             }
             if diag.is_nan() || diag <= 0.0 {
-                bail!("--{name}-rel needs a mesh with a non-zero bounding box; give --{name}");
+                bail!(
+                    "{}: --{name}-rel needs a mesh with a non-zero bounding box (this one's \
+                     diagonal is {diag}: a single point or coincident vertices); give --{name}",
+                    mesh.display()
+                );
             }
-            r / diag
+            let v = r / diag;
+            if let Some(problem) = limits::alpha_problem(v) {
+                bail!(
+                    "{}: --{name}-rel {r} over the diagonal {diag} gives alpha {v}, which {problem}",
+                    mesh.display()
+                );
+            }
+            v
         }
         (None, None) => return Ok(None),
     };
-    if !(v > 0.0 && v.is_finite()) {
-        bail!("--{name} must be a positive number (got {v})");
+    if let Some(problem) = limits::alpha_problem(v) {
+        bail!("--{name} {problem}");
     }
     Ok(Some(v))
 }
 
+/// Reads `x y z` lines from a regular file or standard input, at most
+/// [`limits::MAX_INPUT_BYTES`] in all and [`MAX_LINE_BYTES`] per line, so an endless
+/// input (a device, a runaway pipe) fails instead of exhausting memory.
 fn read_points(path: Option<&PathBuf>) -> Result<Vec<DVec3>> {
-    let (name, reader): (String, Box<dyn BufRead>) = match path {
+    let (name, reader): (String, Box<dyn Read>) = match path {
         Some(p) => (
             p.display().to_string(),
-            Box::new(std::io::BufReader::new(
-                std::fs::File::open(p)
-                    .with_context(|| format!("{}: cannot open query points", p.display()))?,
-            )),
+            Box::new(
+                limits::open_input_file(p)
+                    .with_context(|| format!("{}: cannot read query points", p.display()))?,
+            ),
         ),
         None => ("<stdin>".into(), Box::new(std::io::stdin().lock())),
     };
+    let mut reader = std::io::BufReader::new(reader.take(limits::MAX_INPUT_BYTES + 1));
     let mut out = Vec::new();
-    for (i, line) in reader.lines().enumerate() {
-        let line = line.with_context(|| format!("{name}: cannot read line {}", i + 1))?;
+    let mut total = 0u64;
+    let mut buf = Vec::new();
+    for i in 0.. {
+        buf.clear();
+        let n = (&mut reader)
+            .take(MAX_LINE_BYTES + 1)
+            .read_until(b'\n', &mut buf)
+            .with_context(|| format!("{name}: cannot read line {}", i + 1))?;
+        if n == 0 {
+            break;
+        }
+        total += n as u64;
+        if total > limits::MAX_INPUT_BYTES {
+            bail!(
+                "{name}: more than {} bytes of query points; split the input",
+                limits::MAX_INPUT_BYTES
+            );
+        }
+        if buf.len() as u64 > MAX_LINE_BYTES {
+            bail!(
+                "{name}:{}: line longer than {MAX_LINE_BYTES} bytes (expected `x y z`)",
+                i + 1
+            );
+        }
+        let line = std::str::from_utf8(&buf)
+            .map_err(|_| anyhow::anyhow!("{name}:{}: not UTF-8 text (expected `x y z`)", i + 1))?;
         let t = line.trim();
         if t.is_empty() || t.starts_with('#') {
             continue;
@@ -171,9 +228,12 @@ fn read_points(path: Option<&PathBuf>) -> Result<Vec<DVec3>> {
                 v.len()
             );
         }
-        if v.iter().any(|c| !c.is_finite()) {
+        if let Some(problem) = v.iter().find_map(|&c| limits::query_coordinate_problem(c)) {
+            bail!("{name}:{}: query coordinate {problem}", i + 1);
+        }
+        if out.len() == MAX_QUERY_POINTS {
             bail!(
-                "{name}:{}: query coordinates must be finite, got `{t}`",
+                "{name}:{}: more than {MAX_QUERY_POINTS} query points; split the input",
                 i + 1
             );
         }
