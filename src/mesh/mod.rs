@@ -9,6 +9,7 @@
 mod error;
 mod obj;
 mod ply;
+mod ply_check;
 mod stl;
 
 pub use error::MeshError;
@@ -115,7 +116,7 @@ impl Mesh {
     }
 
     /// Checks the invariants every reader and generator must meet: at least one vertex,
-    /// finite coordinates, indices in range.
+    /// finite coordinates within [`crate::limits::MAX_COORD`], indices in range.
     pub fn validate(&self, path: &Path) -> Result<(), MeshError> {
         if self.vertices.is_empty() {
             return Err(MeshError::Empty {
@@ -127,6 +128,17 @@ impl Mesh {
                 path: path.to_path_buf(),
                 vertex: i,
             });
+        }
+        for (i, v) in self.vertices.iter().enumerate() {
+            for c in v.to_array() {
+                if let Some(problem) = crate::limits::coordinate_problem(f64::from(c)) {
+                    return Err(MeshError::CoordinateOutOfRange {
+                        path: path.to_path_buf(),
+                        vertex: i,
+                        problem,
+                    });
+                }
+            }
         }
         let n = self.vertices.len();
         let bad = self
