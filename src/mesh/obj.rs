@@ -32,16 +32,8 @@ use super::{Mesh, MeshError};
 use glam::Vec3;
 use std::path::Path;
 
-pub(super) fn read_obj(path: &Path) -> Result<Mesh, MeshError> {
-    let bytes = crate::limits::read_input_file(path).map_err(|source| MeshError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    parse_obj(&bytes, path)
-}
-
 /// Parses OBJ text held in `bytes`; `path` is only used in errors.
-fn parse_obj(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
+pub(super) fn parse_obj(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let mut mesh = Mesh::default();
     for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {

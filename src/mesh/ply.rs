@@ -28,21 +28,13 @@ use ply_rs_bw::ply::{
 };
 use std::path::Path;
 
-pub(super) fn read_ply(path: &Path) -> Result<Mesh, MeshError> {
-    let bytes = crate::limits::read_input_file(path).map_err(|source| MeshError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    parse_ply(&bytes, path)
-}
-
 /// Names of the face list property we accept (a face element with both is rejected).
 const FACE_LIST_NAMES: [&str; 2] = ["vertex_indices", "vertex_index"];
 
 /// Parses a whole PLY file held in `bytes`; `path` is only used in errors. (Reading the
 /// file whole was measured faster than streaming it through a `BufReader`, at the cost
 /// of holding the file and the vertices at once: about 200 MB for 8 M points.)
-fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
+pub(super) fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
     let format_err = |message: String| MeshError::Format {
         path: path.to_path_buf(),
         message,

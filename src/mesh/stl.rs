@@ -19,15 +19,7 @@ use std::collections::HashMap;
 use std::io::Cursor;
 use std::path::Path;
 
-pub(super) fn read_stl(path: &Path) -> Result<Mesh, MeshError> {
-    let bytes = crate::limits::read_input_file(path).map_err(|source| MeshError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    parse_stl(bytes, path)
-}
-
-fn parse_stl(mut bytes: Vec<u8>, path: &Path) -> Result<Mesh, MeshError> {
+pub(super) fn parse_stl(mut bytes: Vec<u8>, path: &Path) -> Result<Mesh, MeshError> {
     if bytes.is_empty() {
         return Err(MeshError::Empty {
             path: path.to_path_buf(),
