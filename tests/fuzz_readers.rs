@@ -228,7 +228,10 @@ fn check_outcome(r: &Result<Mesh, MeshError>, path: &Path) {
 // as possible (lines, `#` comments, `v` with three finite coordinates within the
 // limit, `f`/`l`/`p` with 1-based or negative indices `v`, `v/vt`, `v//vn`, `v/vt/vn`).
 
-fn naive_obj(bytes: &[u8]) -> Option<(Vec<[f32; 3]>, Vec<[u32; 3]>, Vec<[u32; 2]>)> {
+/// Vertices, triangles and segments.
+type ObjValues = (Vec<[f32; 3]>, Vec<[u32; 3]>, Vec<[u32; 2]>);
+
+fn naive_obj(bytes: &[u8]) -> Option<ObjValues> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let (mut v, mut f, mut l) = (Vec::new(), Vec::new(), Vec::new());
     for line in bytes.split(|&b| b == b'\n') {
