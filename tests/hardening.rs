@@ -5,22 +5,14 @@ use smoothtrace::mesh::Mesh;
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
+mod common;
+
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_smoothtrace"))
 }
 
 fn run_in(dir: &Path, args: &[&str], stdin: &str) -> Output {
-    use std::io::Write;
-    let mut child = bin()
-        .args(args)
-        .current_dir(dir)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let _ = child.stdin.take().unwrap().write_all(stdin.as_bytes());
-    child.wait_with_output().unwrap()
+    common::run_cli(bin(), args, dir, Some(stdin))
 }
 
 fn stderr(o: &Output) -> String {
@@ -34,6 +26,20 @@ fn expect_error(o: &Output, needles: &[&str]) {
     for n in needles {
         assert!(e.contains(n), "'{n}' not in: {e}");
     }
+}
+
+/// Whether a device the test needs exists (prints why the test skips when not).
+fn device_present(path: &str) -> bool {
+    let present = Path::new(path).exists();
+    if !present {
+        eprintln!("skipping: {path} is absent on this system");
+    }
+    present
+}
+
+/// `query MESH -p points --alpha 1` without query points: loads the mesh, prints nothing.
+fn load_with_query(dir: &Path, mesh: &str) -> Output {
+    run_in(dir, &["query", mesh, "-p", "points", "--alpha", "1"], "")
 }
 
 /// The `query` columns `s gx gy gz dmin leaves` of each output line.
@@ -86,18 +92,10 @@ fn long_skinny_triangle_distance_is_exact() {
     }
     // Coordinates that do not fit f32, or are beyond the limit, are refused by name.
     std::fs::write(dir.path().join("huge.obj"), "v 0 0 0\nv 1e39 0 0\n").unwrap();
-    let o = run_in(
-        dir.path(),
-        &["query", "huge.obj", "-p", "points", "--alpha", "1"],
-        "",
-    );
+    let o = load_with_query(dir.path(), "huge.obj");
     expect_error(&o, &["huge.obj:2", "not finite"]);
     std::fs::write(dir.path().join("big.obj"), "v 0 0 0\nv 0 -2e31 0\n").unwrap();
-    let o = run_in(
-        dir.path(),
-        &["query", "big.obj", "-p", "points", "--alpha", "1"],
-        "",
-    );
+    let o = load_with_query(dir.path(), "big.obj");
     expect_error(&o, &["big.obj:2", "beyond the accepted"]);
     let ply = "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\n\
                property double z\nend_header\n0 0 0\n1e300 0 0\n";
@@ -181,8 +179,7 @@ fn infinite_results_for_finite_queries_are_refused_or_finite() {
 /// a closed standard output made `query` exit 0 with its results lost.
 #[test]
 fn printing_never_panics_and_lost_output_is_an_error() {
-    if !Path::new("/dev/full").exists() {
-        eprintln!("skipping: /dev/full is absent");
+    if !device_present("/dev/full") {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -234,23 +231,22 @@ fn printing_never_panics_and_lost_output_is_an_error() {
         assert_eq!(o.status.code(), Some(code), "{args:?}: {:?}", o.status);
     }
     assert!(dir.path().join("x.png").exists());
-    // Closed standard output: exit 2 with a message (the shell closes fd 1).
-    let o = Command::new("sh")
-        .arg("-c")
-        .arg("echo '0 0 0' | \"$0\" query t.obj -p points --alpha 1 >&-")
-        .arg(env!("CARGO_BIN_EXE_smoothtrace"))
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    expect_error(&o, &["standard output is closed"]);
+    // One query with standard output redirected by the shell.
+    let query_with = |redirect: &str| {
+        Command::new("sh")
+            .arg("-c")
+            .arg(format!(
+                "echo '0 0 0' | \"$0\" query t.obj -p points --alpha 1 {redirect}"
+            ))
+            .arg(env!("CARGO_BIN_EXE_smoothtrace"))
+            .current_dir(dir.path())
+            .output()
+            .unwrap()
+    };
+    // Closed standard output: exit 2 with a message.
+    expect_error(&query_with(">&-"), &["standard output is closed"]);
     // Standard output sent to /dev/null on purpose is fine.
-    let o = Command::new("sh")
-        .arg("-c")
-        .arg("echo '0 0 0' | \"$0\" query t.obj -p points --alpha 1 >/dev/null")
-        .arg(env!("CARGO_BIN_EXE_smoothtrace"))
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
+    let o = query_with(">/dev/null");
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
@@ -258,18 +254,13 @@ fn printing_never_panics_and_lost_output_is_an_error() {
 /// until memory ran out.
 #[test]
 fn unbounded_reads_of_devices_are_refused() {
-    if !Path::new("/dev/zero").exists() {
-        eprintln!("skipping: /dev/zero is absent");
+    if !device_present("/dev/zero") {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
     std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero.ply")).unwrap();
     std::fs::write(dir.path().join("t.obj"), "v 0 0 0\n").unwrap();
-    let o = run_in(
-        dir.path(),
-        &["query", "zero.ply", "-p", "points", "--alpha", "1"],
-        "",
-    );
+    let o = load_with_query(dir.path(), "zero.ply");
     expect_error(&o, &["zero.ply", "not a regular file"]);
     let o = run_in(
         dir.path(),
@@ -287,11 +278,7 @@ fn unbounded_reads_of_devices_are_refused() {
     );
     expect_error(&o, &["/dev/zero", "not a regular file"]);
     std::fs::create_dir(dir.path().join("d.obj")).unwrap();
-    let o = run_in(
-        dir.path(),
-        &["query", "d.obj", "-p", "points", "--alpha", "1"],
-        "",
-    );
+    let o = load_with_query(dir.path(), "d.obj");
     expect_error(&o, &["d.obj", "directory"]);
     // A query line without an end is cut at 64 KiB, not read whole.
     let long = "1".repeat(100_000);

@@ -287,6 +287,16 @@ pub fn closest_on_box(x: DVec3, min: DVec3, max: DVec3) -> (f64, DVec3) {
 mod tests {
     use super::*;
 
+    /// A fixed-seed LCG, uniform in [-1, 1].
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        }
+    }
+
     fn brute_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
         // Dense barycentric sampling plus exact edges: an upper bound close to the truth.
         let n = 200;
@@ -307,13 +317,7 @@ mod tests {
 
     #[test]
     fn triangle_matches_dense_sampling() {
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut rnd = uniform(12345);
         for _ in 0..300 {
             let a = DVec3::new(rnd(), rnd(), rnd());
             let b = DVec3::new(rnd(), rnd(), rnd());
@@ -430,13 +434,7 @@ mod tests {
     /// same vertex, edge or point.
     #[test]
     fn vertex_order_does_not_change_the_result() {
-        let mut seed = 777u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut rnd = uniform(777);
         for _ in 0..500 {
             let v = [(); 3].map(|_| DVec3::new(rnd(), rnd(), rnd()));
             let x = DVec3::new(rnd(), rnd(), rnd()) * 1.5;
