@@ -1,28 +1,16 @@
 //! The command line as a user runs it: the built binary in a temp directory.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Output};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_smoothtrace"))
 }
 
 fn run(args: &[&str], dir: &Path, stdin: Option<&str>) -> Output {
-    use std::io::Write;
-    let mut child = bin()
-        .args(args)
-        .current_dir(dir)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    if let Some(s) = stdin {
-        // The process may exit before reading (bad input): ignore a broken pipe.
-        let _ = child.stdin.take().unwrap().write_all(s.as_bytes());
-    }
-    drop(child.stdin.take());
-    child.wait_with_output().unwrap()
+    common::run_cli(bin(), args, dir, stdin)
 }
 
 fn stderr(o: &Output) -> String {

@@ -684,7 +684,7 @@ fn npy_round_trip_and_preview() {
     assert_eq!(back[grid.index(3, 2, 4)], f.get(3, 2, 4));
 
     let png = dir.path().join("slices.png");
-    f.write_preview_png(&png).unwrap();
+    f.write_preview(&png).unwrap();
     let img = image::open(&png).unwrap().to_rgb8();
     assert!(
         img.width() > 3 * img.height() && img.height() >= 100,

@@ -50,15 +50,22 @@ pub fn resolve_alpha(
             }
             if diag.is_nan() || diag <= 0.0 {
                 return Err(bad(format!(
-                    "{rel_name} needs a mesh with a non-zero bounding box; give {name}"
+                    "{rel_name} needs a mesh with a non-zero bounding box (this one's \
+                     diagonal is {diag}: a single point or coincident vertices); give {name}"
                 )));
             }
-            r / diag
+            let v = r / diag;
+            if let Some(problem) = crate::limits::alpha_problem(v) {
+                return Err(bad(format!(
+                    "{rel_name} {r} over the diagonal {diag} gives alpha {v}, which {problem}"
+                )));
+            }
+            v
         }
         (None, None) => return Ok(None),
     };
-    if !(v > 0.0 && v.is_finite()) {
-        return Err(bad(format!("{name} must be a positive number (got {v})")));
+    if let Some(problem) = crate::limits::alpha_problem(v) {
+        return Err(bad(format!("{name} {problem}")));
     }
     Ok(Some(v))
 }
@@ -151,7 +158,8 @@ mod tests {
         let e = resolve_alpha(Naming::Keyword, "alpha", None, Some(2.0), 0.0).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "alpha_rel needs a mesh with a non-zero bounding box; give alpha"
+            "alpha_rel needs a mesh with a non-zero bounding box (this one's diagonal is 0: \
+             a single point or coincident vertices); give alpha"
         );
         assert_eq!(
             resolve_alpha(Naming::Keyword, "alpha", None, Some(3.0), 2.0).unwrap(),

@@ -1,6 +1,7 @@
 //! `smoothtrace bench`: the paper's Table 1 rendered on this machine (see
 //! `smoothtrace::reports::bench`).
 
+use super::console::{Stdout, note};
 use super::progress::Bars;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -90,24 +91,31 @@ pub fn run(a: BenchArgs) -> Result<()> {
         paper_mode,
     };
     bench::select_rows(&opts.rows)?;
+    super::outputs::check_report_outputs(&a.csv, &a.json, None)?;
     let pool =
         smoothtrace::reports::pool(opts.threads).context("cannot start the worker threads")?;
     let bars = Bars::default();
     let rows = pool.install(|| {
         bench::run(&opts, &bars, |r| match &r.result {
-            Ok(m) => eprintln!(
+            Ok(m) => note!(
                 "{}: {:.3} s ({} x {}, {} threads)",
-                r.paper.name, m.stats.seconds, m.stats.width, m.stats.height, m.stats.threads
+                r.paper.name,
+                m.stats.seconds,
+                m.stats.width,
+                m.stats.height,
+                m.stats.threads
             ),
-            Err(reason) => eprintln!("{}: skipped: {reason}", r.paper.name),
+            Err(reason) => note!("{}: skipped: {reason}", r.paper.name),
         })
     })?;
     let table = bench::table(&rows);
-    print!("{}", bench::text(&table));
-    println!(
-        "paper: 2015 laptop, 4 cores, 1920x1080; ours: {} threads; times are the tracing loop only",
+    let mut out = Stdout::open()?;
+    out.write(&bench::text(&table))?;
+    out.write(&format!(
+        "paper: 2015 laptop, 4 cores, 1920x1080; ours: {} threads; times are the tracing loop only\n",
         rayon_threads(&rows)
-    );
+    ))?;
+    out.finish()?;
     if let Some(p) = &a.csv {
         table
             .write_csv(p)

@@ -1,10 +1,12 @@
 //! `smoothtrace field`: an exact (or smooth) distance field on a voxel grid, written as
 //! `.npy` (f32, shape `(NZ, NY, NX)`), with an optional PNG montage of slices.
 
+use super::console::note;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use smoothtrace::field::{self, Domains, FieldOptions, Grid, Method};
+use smoothtrace::output::{IMAGE_8BIT, Kind, Output};
 use smoothtrace::primitives::PrimitiveKind;
 use std::path::PathBuf;
 
@@ -69,15 +71,20 @@ pub struct FieldArgs {
     /// Output `.npy` file.
     #[arg(long, short)]
     output: PathBuf,
-    /// Also write a PNG montage of a few z slices.
-    #[arg(long, value_name = "PNG")]
+    /// Also write a montage of a few z slices (.png, .jpg/.jpeg or .webp).
+    #[arg(long, value_name = "IMAGE")]
     preview: Option<PathBuf>,
 }
 
 pub fn run(a: FieldArgs) -> Result<()> {
+    // Outputs are checked before the work (issue 10, defects 5 and 7).
+    Output::check(&a.output, &[Kind::Npy], "the distance field")?;
+    if let Some(p) = &a.preview {
+        Output::check(p, IMAGE_8BIT, "the preview")?;
+    }
     let (mesh, origin) = smoothtrace::las::load_mesh(&a.mesh, &[a.primitive])?;
     if origin != DVec3::ZERO {
-        eprintln!(
+        note!(
             "{}: lidar points recentred: grid coordinates are file coordinates minus [{}, {}, {}]",
             a.mesh.display(),
             origin.x,
@@ -122,7 +129,7 @@ pub fn run(a: FieldArgs) -> Result<()> {
         memory_limit: None,
     };
     let h = grid.spacing();
-    eprintln!(
+    note!(
         "{}: {} {}, grid {} x {} x {} = {} voxels",
         a.mesh.display(),
         mesh.name,
@@ -132,9 +139,17 @@ pub fn run(a: FieldArgs) -> Result<()> {
         grid.res[2],
         grid.len()
     );
-    eprintln!(
+    note!(
         "  bounds [{}, {}, {}] .. [{}, {}, {}], spacing {} x {} x {}",
-        grid.min.x, grid.min.y, grid.min.z, grid.max.x, grid.max.y, grid.max.z, h.x, h.y, h.z
+        grid.min.x,
+        grid.min.y,
+        grid.min.z,
+        grid.max.x,
+        grid.max.y,
+        grid.max.z,
+        h.x,
+        h.y,
+        h.z
     );
     let (f, s) = field::compute(&mesh, a.primitive, &grid, method, &options)?;
     let mut line = format!(
@@ -159,16 +174,16 @@ pub fn run(a: FieldArgs) -> Result<()> {
     } else {
         line += &format!(", {} primitives", s.sites);
     }
-    eprintln!("{line}");
+    note!("{line}");
     if let Some(b) = a.band {
         let inside = f.values.iter().filter(|v| v.is_finite()).count();
-        eprintln!("  band {b}: {inside} voxels within it, the others hold +inf");
+        note!("  band {b}: {inside} voxels within it, the others hold +inf");
     }
     f.write_npy(&a.output)?;
-    eprintln!("  wrote {}", a.output.display());
+    note!("  wrote {}", a.output.display());
     if let Some(p) = &a.preview {
-        f.write_preview_png(p)?;
-        eprintln!("  wrote {}", p.display());
+        f.write_preview(p)?;
+        note!("  wrote {}", p.display());
     }
     Ok(())
 }

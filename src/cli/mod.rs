@@ -3,7 +3,9 @@
 //! their cause chain and exit status 2.
 
 mod bench;
+pub(crate) mod console;
 mod field;
+mod outputs;
 mod progress;
 mod query;
 mod render;
@@ -54,9 +56,9 @@ pub fn run() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("smoothtrace: error: {e}");
+            console::note!("smoothtrace: error: {e}");
             for cause in e.chain().skip(1) {
-                eprintln!("  caused by: {cause}");
+                console::note!("  caused by: {cause}");
             }
             ExitCode::from(2)
         }

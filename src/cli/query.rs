@@ -1,14 +1,23 @@
 //! `smoothtrace query`: smooth distance, gradient, exact distance and leaves visited at
 //! points read from a file or standard input.
 
+use super::console::{Stdout, note};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::DVec3;
 use smoothtrace::api::params::{self, Naming};
 use smoothtrace::eval::{self, Accumulation, EvalParams};
+use smoothtrace::limits;
 use smoothtrace::primitives::{AnySet, PrimitiveKind};
-use std::io::{BufRead, BufWriter, Write};
+use std::io::{BufRead, Read};
 use std::path::PathBuf;
+
+/// Longest accepted line of query points.
+const MAX_LINE_BYTES: u64 = 64 * 1024;
+
+/// Most query points per run: the points and their result lines are held in memory
+/// (about 150 bytes each, 1.5 GB at this limit).
+const MAX_QUERY_POINTS: usize = 10_000_000;
 
 #[derive(Args, Debug)]
 pub struct QueryArgs {
@@ -47,6 +56,8 @@ pub struct QueryArgs {
 
 pub fn run(a: QueryArgs) -> Result<()> {
     params::check_beta(Naming::Flag, a.beta)?;
+    // Before any work: a closed standard output fails here.
+    let mut out = Stdout::open()?;
     // Lidar coordinates are recentred on load; query points stay in file coordinates.
     let (mesh, origin) = smoothtrace::las::load_mesh(&a.mesh, &a.primitive)?;
     let mut sets = Vec::new();
@@ -56,22 +67,18 @@ pub fn run(a: QueryArgs) -> Result<()> {
         }
     }
     let diag = mesh.bounds().diagonal();
-    let alpha = params::resolve_alpha(Naming::Flag, "alpha", a.alpha, a.alpha_rel, diag)?
-        .context("give --alpha or --alpha-rel")?;
-    let max_alpha = params::resolve_alpha(
-        Naming::Flag,
-        "max_alpha",
-        a.max_alpha,
-        a.max_alpha_rel,
-        diag,
-    )?
-    .unwrap_or(alpha);
+    let resolve = |key: &str, abs, rel| {
+        params::resolve_alpha(Naming::Flag, key, abs, rel, diag)
+            .with_context(|| a.mesh.display().to_string())
+    };
+    let alpha = resolve("alpha", a.alpha, a.alpha_rel)?.context("give --alpha or --alpha-rel")?;
+    let max_alpha = resolve("max_alpha", a.max_alpha, a.max_alpha_rel)?.unwrap_or(alpha);
     let mut params = EvalParams::new(alpha, max_alpha, a.beta);
     if a.naive {
         params.accumulation = Accumulation::Naive;
     }
     let n: usize = sets.iter().map(|s| s.len()).sum();
-    eprintln!(
+    note!(
         "{}: {} {} ({} primitives), diagonal {diag}, alpha {alpha} (alpha * diagonal = {}), max_alpha {max_alpha}, beta {}, {} accumulation",
         a.mesh.display(),
         mesh.name,
@@ -110,14 +117,13 @@ pub fn run(a: QueryArgs) -> Result<()> {
             .collect()
     };
     let underflows = results.iter().filter(|l| l.starts_with("inf")).count();
-    let stdout = std::io::stdout();
-    let mut out = BufWriter::new(stdout.lock());
     for line in &results {
-        writeln!(out, "{line}")?;
+        out.write(line)?;
+        out.write("\n")?;
     }
-    out.flush()?;
-    if underflows > 0 {
-        eprintln!(
+    out.finish()?;
+    if a.naive && underflows > 0 {
+        note!(
             "warning: the naive sum underflowed (s = inf) at {underflows} of {} queries; the stable evaluation (without --naive) does not",
             results.len()
         );
@@ -125,20 +131,48 @@ pub fn run(a: QueryArgs) -> Result<()> {
     Ok(())
 }
 
+/// Reads `x y z` lines from a regular file or standard input, at most
+/// [`limits::MAX_INPUT_BYTES`] in all and [`MAX_LINE_BYTES`] per line, so an endless
+/// input (a device, a runaway pipe) fails instead of exhausting memory.
 fn read_points(path: Option<&PathBuf>) -> Result<Vec<DVec3>> {
-    let (name, reader): (String, Box<dyn BufRead>) = match path {
+    let (name, reader): (String, Box<dyn Read>) = match path {
         Some(p) => (
             p.display().to_string(),
-            Box::new(std::io::BufReader::new(
-                std::fs::File::open(p)
-                    .with_context(|| format!("{}: cannot open query points", p.display()))?,
-            )),
+            Box::new(
+                limits::open_input_file(p)
+                    .with_context(|| format!("{}: cannot read query points", p.display()))?,
+            ),
         ),
         None => ("<stdin>".into(), Box::new(std::io::stdin().lock())),
     };
+    let mut reader = std::io::BufReader::new(reader.take(limits::MAX_INPUT_BYTES + 1));
     let mut out = Vec::new();
-    for (i, line) in reader.lines().enumerate() {
-        let line = line.with_context(|| format!("{name}: cannot read line {}", i + 1))?;
+    let mut total = 0u64;
+    let mut buf = Vec::new();
+    for i in 0.. {
+        buf.clear();
+        let n = (&mut reader)
+            .take(MAX_LINE_BYTES + 1)
+            .read_until(b'\n', &mut buf)
+            .with_context(|| format!("{name}: cannot read line {}", i + 1))?;
+        if n == 0 {
+            break;
+        }
+        total += n as u64;
+        if total > limits::MAX_INPUT_BYTES {
+            bail!(
+                "{name}: more than {} bytes of query points; split the input",
+                limits::MAX_INPUT_BYTES
+            );
+        }
+        if buf.len() as u64 > MAX_LINE_BYTES {
+            bail!(
+                "{name}:{}: line longer than {MAX_LINE_BYTES} bytes (expected `x y z`)",
+                i + 1
+            );
+        }
+        let line = std::str::from_utf8(&buf)
+            .map_err(|_| anyhow::anyhow!("{name}:{}: not UTF-8 text (expected `x y z`)", i + 1))?;
         let t = line.trim();
         if t.is_empty() || t.starts_with('#') {
             continue;
@@ -160,9 +194,12 @@ fn read_points(path: Option<&PathBuf>) -> Result<Vec<DVec3>> {
                 v.len()
             );
         }
-        if v.iter().any(|c| !c.is_finite()) {
+        if let Some(problem) = v.iter().find_map(|&c| limits::query_coordinate_problem(c)) {
+            bail!("{name}:{}: query coordinate {problem}", i + 1);
+        }
+        if out.len() == MAX_QUERY_POINTS {
             bail!(
-                "{name}:{}: query coordinates must be finite, got `{t}`",
+                "{name}:{}: more than {MAX_QUERY_POINTS} query points; split the input",
                 i + 1
             );
         }

@@ -1,10 +1,12 @@
 //! `smoothtrace render`: a scene file to a PNG, with a progress bar, a one-line summary,
 //! and optional statistics (JSON) and depth (EXR) outputs.
 
+use super::console::note;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use smoothtrace::api::params::{Naming, SceneOverrides};
+use smoothtrace::output::{IMAGE_8BIT, Kind, Output};
 use smoothtrace::render::TracerOptions;
 use smoothtrace::render::build::BuiltScene;
 use smoothtrace::render::image::{ImageStats, Rendered};
@@ -16,7 +18,7 @@ use std::path::{Path, PathBuf};
 pub struct RenderArgs {
     /// Scene file (TOML; see the README for the format).
     scene: PathBuf,
-    /// Output image (PNG).
+    /// Output image (.png, .jpg/.jpeg or .webp, by the extension).
     #[arg(short, long)]
     output: PathBuf,
     /// Override the image width.
@@ -116,12 +118,24 @@ pub fn run(a: RenderArgs) -> Result<()> {
     if !(a.coarse_beta >= 0.0 && a.coarse_beta.is_finite()) {
         bail!("--coarse-beta must be >= 0 (got {})", a.coarse_beta);
     }
+    // Every output is checked before the render (issue 10, defect 5).
+    let output = Output::check(&a.output, IMAGE_8BIT, "the rendered image")?;
+    let stats = a
+        .stats
+        .as_deref()
+        .map(|p| Output::check_as(p, Kind::Json))
+        .transpose()?;
+    let depth = a
+        .depth
+        .as_deref()
+        .map(|p| Output::check(p, &[Kind::Exr], "the depth image"))
+        .transpose()?;
     let (built, rendered) = render_scene(&scene, &a.scene.display().to_string(), a.coarse_beta)?;
     if a.verbose {
         for s in &built.steps {
-            eprintln!("object[{}] {} ({:.3} s)", s.object, s.what, s.seconds);
+            note!("object[{}] {} ({:.3} s)", s.object, s.what, s.seconds);
         }
-        eprintln!(
+        note!(
             "epsilon {} (scene diagonal {})",
             built.epsilon,
             built.bounds.diagonal()
@@ -135,25 +149,23 @@ pub fn run(a: RenderArgs) -> Result<()> {
             scene.camera.origin
         );
     }
-    rendered
-        .image
-        .save(&a.output)
-        .with_context(|| format!("cannot write {}", a.output.display()))?;
-    if let Some(p) = &a.stats {
-        write_stats_json(p, &a.scene, st, &built)?;
+    output.write_image(&image::DynamicImage::ImageRgb8(rendered.image.clone()))?;
+    if let Some(out) = &stats {
+        write_stats_json(out, &a.scene, st, &built)?;
     }
-    if let Some(p) = &a.depth {
-        write_depth_exr(p, &rendered)?;
+    if let Some(out) = &depth {
+        write_depth_exr(out, &rendered)?;
     }
-    eprintln!("{}", summary(&a.scene, st, &a.output));
+    note!("{}", summary(&a.scene, st, &a.output));
     if st.exhausted > 0 {
-        eprintln!(
+        note!(
             "warning: {} rays ran out of steps (max_steps = {}) and were drawn as misses",
-            st.exhausted, scene.render.max_steps
+            st.exhausted,
+            scene.render.max_steps
         );
     }
     if st.falloffs > 0 {
-        eprintln!(
+        note!(
             "note: alpha falloff fired {} times (the naive sum underflowed)",
             st.falloffs
         );
@@ -182,7 +194,7 @@ pub fn summary(scene: &Path, st: &ImageStats, output: &Path) -> String {
     )
 }
 
-fn write_stats_json(path: &Path, scene: &Path, st: &ImageStats, built: &BuiltScene) -> Result<()> {
+fn write_stats_json(out: &Output, scene: &Path, st: &ImageStats, built: &BuiltScene) -> Result<()> {
     let json = serde_json::json!({
         "scene": scene.display().to_string(),
         "image": st,
@@ -193,14 +205,12 @@ fn write_stats_json(path: &Path, scene: &Path, st: &ImageStats, built: &BuiltSce
         "epsilon": built.epsilon,
         "build": built.steps,
     });
-    std::fs::write(path, serde_json::to_string_pretty(&json)?)
-        .with_context(|| format!("cannot write {}", path.display()))
+    Ok(out.write_bytes(serde_json::to_string_pretty(&json)?.as_bytes())?)
 }
 
-fn write_depth_exr(path: &Path, r: &Rendered) -> Result<()> {
+fn write_depth_exr(out: &Output, r: &Rendered) -> Result<()> {
     let (w, h) = (r.image.width(), r.image.height());
     let data: Vec<f32> = r.depth.iter().flat_map(|&d| [d, d, d]).collect();
     let img = image::Rgb32FImage::from_raw(w, h, data).context("depth buffer size")?;
-    img.save(path)
-        .with_context(|| format!("cannot write {}", path.display()))
+    Ok(out.write_image(&image::DynamicImage::ImageRgb32F(img))?)
 }

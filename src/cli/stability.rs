@@ -2,6 +2,7 @@
 //! `smoothtrace::reports::stability`). Exit status 1 when the stable evaluator violates
 //! anything (the naive one's infinities are expected and only reported).
 
+use super::console::{Stdout, note};
 use super::progress::Bars;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -31,9 +32,11 @@ pub fn run(a: StabilityArgs) -> Result<()> {
     }
     let pool = smoothtrace::reports::pool(a.threads as usize)
         .context("cannot start the worker threads")?;
+    super::outputs::check_report_outputs(&a.csv, &a.json, None)?;
     let report = pool.install(|| stability::run(a.size, &Bars::default()));
     let table = stability::table(&report);
-    print!("{}", stability::text(&table));
+    let mut out = Stdout::open()?;
+    out.write(&stability::text(&table))?;
     if let Some(p) = &a.csv {
         table
             .write_csv(p)
@@ -49,13 +52,14 @@ pub fn run(a: StabilityArgs) -> Result<()> {
         .filter(|r| r.evaluator == stability::Evaluator::Naive && !r.violations.is_empty())
         .count();
     let bad = report.stable_violations();
-    println!(
-        "stable evaluator: {} violation(s); naive evaluator: {naive} case(s) with infinities, NaN or other failures (expected far away and at stiff alpha)",
+    out.write(&format!(
+        "stable evaluator: {} violation(s); naive evaluator: {naive} case(s) with infinities, NaN or other failures (expected far away and at stiff alpha)\n",
         bad.len()
-    );
+    ))?;
+    out.finish()?;
     if !bad.is_empty() {
         for v in &bad {
-            eprintln!("smoothtrace: stable evaluator: {v}");
+            note!("smoothtrace: stable evaluator: {v}");
         }
         std::process::exit(1);
     }

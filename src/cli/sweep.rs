@@ -1,6 +1,7 @@
 //! `smoothtrace sweep SCENE...`: render time against isosurface error over beta, or the
 //! Thingi10K-style query grid with `--grid N` (see `smoothtrace::reports::sweep`).
 
+use super::console::{Stdout, note};
 use super::progress::Bars;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -8,7 +9,7 @@ use smoothtrace::reports::sweep::{self, GridOptions, SweepOptions};
 use smoothtrace::reports::table::{Table, write_file};
 use smoothtrace::reports::{parse_list, plot};
 use smoothtrace::scene::AlphaSpec;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct SweepArgs {
@@ -69,7 +70,9 @@ fn size(name: &str, v: Option<i64>) -> Result<Option<u32>> {
 }
 
 fn write_outputs(a: &SweepArgs, table: &Table) -> Result<()> {
-    print!("{}", table.to_text());
+    let mut out = Stdout::open()?;
+    out.write(&table.to_text())?;
+    out.finish()?;
     if let Some(p) = &a.csv {
         table
             .write_csv(p)
@@ -78,13 +81,6 @@ fn write_outputs(a: &SweepArgs, table: &Table) -> Result<()> {
     if let Some(p) = &a.json {
         write_file(p, &serde_json::to_string_pretty(&table.to_json())?)
             .with_context(|| format!("cannot write {}", p.display()))?;
-    }
-    Ok(())
-}
-
-fn create_parent(p: &Path) -> Result<()> {
-    if let Some(d) = p.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(d).with_context(|| format!("cannot create {}", d.display()))?;
     }
     Ok(())
 }
@@ -119,6 +115,7 @@ pub fn run(a: SweepArgs) -> Result<()> {
         paper_mode: a.paper_mode,
     };
     opts.validate()?;
+    super::outputs::check_report_outputs(&a.csv, &a.json, a.plot.as_ref())?;
     let pool =
         smoothtrace::reports::pool(opts.threads).context("cannot start the worker threads")?;
     let bars = Bars::default();
@@ -133,15 +130,17 @@ pub fn run(a: SweepArgs) -> Result<()> {
         };
         let rows = pool.install(|| {
             sweep::run_grid(&g, &bars, |r| {
-                eprintln!(
+                note!(
                     "{} beta {}: {:.2} us/query, {:.1} leaves/query",
-                    r.scene, r.beta, r.us_per_query, r.leaves_mean
+                    r.scene,
+                    r.beta,
+                    r.us_per_query,
+                    r.leaves_mean
                 )
             })
         })?;
         write_outputs(&a, &sweep::grid_table(&rows))?;
         if let Some(p) = &a.plot {
-            create_parent(p)?;
             let title = format!(
                 "Time per query against leaves visited ({n}^3 grid, diagonal 0.5, {} threads)",
                 pool.current_num_threads()
@@ -152,7 +151,7 @@ pub fn run(a: SweepArgs) -> Result<()> {
     }
     let rows = pool.install(|| {
         sweep::run(&opts, &bars, |r| {
-            eprintln!(
+            note!(
                 "{} beta {} {}: {:.3} s, mean error {:.2e}",
                 r.scene,
                 r.beta,
@@ -164,7 +163,6 @@ pub fn run(a: SweepArgs) -> Result<()> {
     })?;
     write_outputs(&a, &sweep::table(&rows))?;
     if let Some(p) = &a.plot {
-        create_parent(p)?;
         let (w, h) = rows.first().map(|r| (r.width, r.height)).unwrap_or((0, 0));
         let title = format!(
             "Render time and isosurface error against beta ({w}x{h}, {} threads)",

@@ -2,7 +2,6 @@
 //! to fix it.
 
 use crate::primitives::PrimitiveError;
-use std::path::PathBuf;
 
 #[derive(Debug, thiserror::Error)]
 pub enum FieldError {
@@ -18,6 +17,12 @@ pub enum FieldError {
     },
     #[error("the bounds must be finite numbers (got min {min:?}, max {max:?})")]
     NonFiniteBounds { min: [f64; 3], max: [f64; 3] },
+    #[error("the bounds' {corner} {axis} {problem}")]
+    BoundsTooLarge {
+        corner: &'static str,
+        axis: char,
+        problem: String,
+    },
     #[error(
         "the bounds are inverted along {axis}: min {min} > max {max}; give the minimum corner first"
     )]
@@ -49,18 +54,8 @@ pub enum FieldError {
     BadSmoothParameters(String),
     #[error(transparent)]
     Primitive(#[from] PrimitiveError),
-    #[error("{}: cannot write: {source}", path.display())]
-    Io {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
-    #[error("{}: cannot write the preview image: {source}", path.display())]
-    Image {
-        path: PathBuf,
-        #[source]
-        source: image::ImageError,
-    },
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
 }
 
 /// `1.5 GiB`-style rendering of a byte count.

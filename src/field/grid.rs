@@ -217,6 +217,17 @@ fn check_bounds(min: DVec3, max: DVec3) -> Result<(), FieldError> {
             max: max.to_array(),
         });
     }
+    for (corner, v) in [("min", min), ("max", max)] {
+        for a in 0..3 {
+            if let Some(problem) = crate::limits::query_coordinate_problem(v[a]) {
+                return Err(FieldError::BoundsTooLarge {
+                    corner,
+                    axis: AXES[a],
+                    problem,
+                });
+            }
+        }
+    }
     for a in 0..3 {
         if min[a] > max[a] {
             return Err(FieldError::InvertedBounds {

@@ -186,14 +186,12 @@ pub fn compute(
         beta,
     } = method
     {
-        if !(alpha > 0.0 && alpha.is_finite()) {
-            return Err(FieldError::BadSmoothParameters(format!(
-                "alpha must be positive and finite (got {alpha})"
-            )));
+        if let Some(problem) = crate::limits::alpha_problem(alpha) {
+            return Err(FieldError::BadSmoothParameters(format!("alpha {problem}")));
         }
-        if !(max_alpha > 0.0 && max_alpha.is_finite()) {
+        if let Some(problem) = crate::limits::alpha_problem(max_alpha) {
             return Err(FieldError::BadSmoothParameters(format!(
-                "max_alpha must be positive and finite (got {max_alpha})"
+                "max_alpha {problem}"
             )));
         }
         if !(0.0..=1.0).contains(&beta) {

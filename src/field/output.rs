@@ -1,11 +1,11 @@
-//! Writing a field: `.npy` (f32, C order, shape `(NZ, NY, NX)`) and a PNG montage of a
-//! few z slices with a colour map and isolines.
+//! Writing a field: `.npy` (f32, C order, shape `(NZ, NY, NX)`) and a PNG/JPEG/WebP
+//! montage of a few z slices with a colour map and isolines.
 
 use super::error::FieldError;
 use super::volume::DistanceField;
+use crate::output::{IMAGE_8BIT, Kind, Output, OutputError};
 use image::{Rgb, RgbImage};
 use npyz::WriterBuilder;
-use std::io::{BufWriter, Write};
 use std::path::Path;
 
 /// Number of slices in the preview montage (fewer if the grid has fewer).
@@ -13,22 +13,26 @@ pub const PREVIEW_SLICES: usize = 5;
 
 impl DistanceField {
     /// Writes the values as a NumPy `.npy` array of `<f4`, shape `(NZ, NY, NX)`, C order
-    /// (`+inf` outside the band).
+    /// (`+inf` outside the band), through a temporary file renamed on success
+    /// ([`crate::output`]).
     pub fn write_npy(&self, path: &Path) -> Result<(), FieldError> {
-        let io = |source: std::io::Error| FieldError::Io {
+        let out = Output::check(path, &[Kind::Npy], "a distance field")?;
+        let io = |source: std::io::Error| OutputError::Write {
             path: path.to_path_buf(),
             source,
         };
-        let file = std::fs::File::create(path).map_err(io)?;
         let [nz, ny, nx] = self.grid.shape();
-        let mut w = npyz::WriteOptions::<f32>::new()
-            .default_dtype()
-            .shape(&[nz as u64, ny as u64, nx as u64])
-            .writer(BufWriter::new(file))
-            .begin_nd()
-            .map_err(io)?;
-        w.extend(self.values.iter().copied()).map_err(io)?;
-        w.finish().map_err(io)
+        out.write_with(|file| {
+            let mut w = npyz::WriteOptions::<f32>::new()
+                .default_dtype()
+                .shape(&[nz as u64, ny as u64, nx as u64])
+                .writer(file)
+                .begin_nd()
+                .map_err(io)?;
+            w.extend(self.values.iter().copied()).map_err(io)?;
+            w.finish().map_err(io)?;
+            Ok::<(), FieldError>(())
+        })
     }
 
     /// Renders up to [`PREVIEW_SLICES`] evenly spaced z slices side by side (x to the
@@ -107,23 +111,12 @@ impl DistanceField {
         img
     }
 
-    /// Writes [`Self::preview_image`] as a PNG.
-    pub fn write_preview_png(&self, path: &Path) -> Result<(), FieldError> {
-        let img = self.preview_image();
-        let file = std::fs::File::create(path).map_err(|source| FieldError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        let mut w = BufWriter::new(file);
-        img.write_to(&mut w, image::ImageFormat::Png)
-            .map_err(|source| FieldError::Image {
-                path: path.to_path_buf(),
-                source,
-            })?;
-        w.flush().map_err(|source| FieldError::Io {
-            path: path.to_path_buf(),
-            source,
-        })
+    /// Writes [`Self::preview_image`] as PNG, JPEG or WebP (by the extension), through
+    /// a temporary file renamed on success.
+    pub fn write_preview(&self, path: &Path) -> Result<(), FieldError> {
+        let out = Output::check(path, IMAGE_8BIT, "the preview")?;
+        out.write_image(&image::DynamicImage::ImageRgb8(self.preview_image()))?;
+        Ok(())
     }
 }
 

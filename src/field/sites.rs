@@ -45,7 +45,7 @@
 //! interval where the site's squared distance (a quadratic along the row) is `<= b^2`.
 //!
 //! Degenerate input: triangles that [`closest_on_triangle`](crate::geometry::closest)
-//! treats as degenerate (squared sine of the angle at the first vertex below 1e-14) have
+//! treats as degenerate (squared sine of the largest angle below 1e-14) have
 //! no face site (their distance is that of their edges, which are edge sites);
 //! zero-length edges have no edge site (their end vertex is a site); a degenerate face
 //! contributes no wedge constraint; a zero-length neighbour direction no cone constraint.
@@ -53,9 +53,6 @@
 use crate::mesh::Mesh;
 use crate::primitives::PrimitiveKind;
 use glam::DVec3;
-
-/// Same threshold as `geometry::closest` uses to call a triangle degenerate.
-const DEGENERATE_SIN2: f64 = 1e-14;
 
 /// Which domains to use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -223,15 +220,7 @@ pub(crate) fn build_sites(
 
 /// Unit normal of a non-degenerate triangle (same test as `closest_on_triangle`).
 fn face_normal(a: DVec3, b: DVec3, c: DVec3) -> Option<DVec3> {
-    let ab = b - a;
-    let ac = c - a;
-    let n = ab.cross(ac);
-    let n2 = n.length_squared();
-    if n2 > DEGENERATE_SIN2 * ab.length_squared() * ac.length_squared() {
-        Some(n / n2.sqrt())
-    } else {
-        None
-    }
+    crate::geometry::closest::triangle_normal(a, b, c).map(|n| n / n.length())
 }
 
 /// Sorted unique undirected edges `[min, max]` without self-loops.

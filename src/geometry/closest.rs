@@ -8,9 +8,15 @@
 
 use glam::DVec3;
 
-/// Below this `|ab x ac|^2 / (|ab|^2 |ac|^2)` (the squared sine of the angle at `a`) a
-/// triangle is treated as degenerate. f64 rounding of the cross product of f32 inputs
-/// is about 1e-16 relative, far below this.
+/// Below this squared sine of a triangle's *largest* angle, `|e1 x e2|^2 / (|e1|^2
+/// |e2|^2)` with `e1`, `e2` the two edges that meet there (the two shortest), the
+/// triangle is treated as degenerate. The largest angle is what makes the test
+/// scale-free *and* shape-fair: a long thin triangle (one vertex 1e9 away, two close
+/// together) has a tiny angle at its far vertex but a large one at the near vertices, so
+/// it is not degenerate, while a collinear or zero-area triangle has a largest angle of
+/// (nearly) 0 or 180 degrees. Below the threshold the triangle's width is under 1e-7 of
+/// its two shorter edges, so its edges give the distance to that relative accuracy.
+/// f64 rounding of the cross product of f32 inputs is about 1e-16 relative.
 const DEGENERATE_SIN2: f64 = 1e-14;
 
 /// Closest point on segment `[a, b]` to `x`.
@@ -85,55 +91,159 @@ pub struct TriangleClosest {
 }
 
 /// Closest point on triangle `(a, b, c)` to `x`, by Voronoi regions (Ericson, Real-Time
-/// Collision Detection, 5.1.5), with no absolute epsilon anywhere. A triangle whose
-/// angle at `a` has a squared sine below 1e-14 (zero area, coincident or collinear
-/// vertices) returns the closest point of its three edges, tagged `Degenerate`.
+/// Collision Detection, 5.1.5), with no absolute epsilon anywhere.
+///
+/// The regions are computed from the vertex with the largest angle (opposite the longest
+/// edge): from there both spanning edges are the short ones, so a long thin triangle
+/// with a far vertex loses no precision to products of huge dot products, and the
+/// degeneracy test is the squared sine of that angle (see `DEGENERATE_SIN2`). The result
+/// is expressed in the caller's order: `point = a + s (b - a) + t (c - a)`, with the
+/// feature named for `a`, `b`, `c`. A degenerate triangle (zero area, coincident or
+/// collinear vertices, NaN input) returns the closest point of its three edges, tagged
+/// `Degenerate`.
 #[inline]
 pub fn closest_on_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> TriangleClosest {
+    let l_bc = (c - b).length_squared();
+    let l_ac = (c - a).length_squared();
+    let l_ab = (b - a).length_squared();
+    let solved = if l_bc >= l_ac && l_bc >= l_ab {
+        // The largest angle is at `a`: no rotation.
+        closest_from_largest_angle(x, a, b, c)
+    } else if l_ac >= l_ab {
+        // Largest angle at `b`: solve for (b, c, a), then map back.
+        closest_from_largest_angle(x, b, c, a).map(|r| {
+            let [ub, uc, _] = weights_of(&r);
+            let feature = rotate_feature(r.feature, [F::VertexB, F::VertexC, F::VertexA]);
+            tri(r.point, ub, uc, feature)
+        })
+    } else {
+        // Largest angle at `c`: solve for (c, a, b), then map back.
+        closest_from_largest_angle(x, c, a, b).map(|r| {
+            let [uc, _, ub] = weights_of(&r);
+            let feature = rotate_feature(r.feature, [F::VertexC, F::VertexA, F::VertexB]);
+            tri(r.point, ub, uc, feature)
+        })
+    };
+    solved.unwrap_or_else(|| closest_on_degenerate_triangle(x, a, b, c))
+}
+
+/// True when `closest_on_triangle` treats `(a, b, c)` as degenerate (the squared sine of
+/// its largest angle is below 1e-14, or a coordinate is NaN).
+pub fn triangle_is_degenerate(a: DVec3, b: DVec3, c: DVec3) -> bool {
+    triangle_normal(a, b, c).is_none()
+}
+
+/// The (unnormalised) normal of a non-degenerate triangle, `(b - a) x (c - a)` computed
+/// from its largest angle (same direction, better rounding); `None` when
+/// `closest_on_triangle` treats the triangle as degenerate.
+pub fn triangle_normal(a: DVec3, b: DVec3, c: DVec3) -> Option<DVec3> {
+    let l_bc = (c - b).length_squared();
+    let l_ac = (c - a).length_squared();
+    let l_ab = (b - a).length_squared();
+    let (o, p, q) = if l_bc >= l_ac && l_bc >= l_ab {
+        (a, b, c)
+    } else if l_ac >= l_ab {
+        (b, c, a)
+    } else {
+        (c, a, b)
+    };
+    let (e1, e2) = (p - o, q - o);
+    let n = e1.cross(e2);
+    let n2 = n.length_squared();
+    // Zero-length edges give 0 <= 0; NaN input fails the comparison.
+    if n2 > DEGENERATE_SIN2 * e1.length_squared() * e2.length_squared() {
+        Some(n)
+    } else {
+        None
+    }
+}
+
+use TriFeature as F;
+
+/// Barycentric weights `(u_a, u_b, u_c)` of a result in its own vertex order, with the
+/// weights that are zero on its feature set exactly (not `1 - s - t` rounded).
+#[inline]
+fn weights_of(r: &TriangleClosest) -> [f64; 3] {
+    let ua = match r.feature {
+        F::VertexB | F::VertexC | F::EdgeBC => 0.0,
+        F::VertexA => 1.0,
+        _ => 1.0 - r.s - r.t,
+    };
+    [ua, r.s, r.t]
+}
+
+/// The feature of a rotated solve in the caller's names; `v` names the rotated solve's
+/// vertices A, B, C.
+#[inline]
+fn rotate_feature(f: TriFeature, v: [TriFeature; 3]) -> TriFeature {
+    let edge = |p: TriFeature, q: TriFeature| match (p, q) {
+        (F::VertexA, F::VertexB) | (F::VertexB, F::VertexA) => F::EdgeAB,
+        (F::VertexA, F::VertexC) | (F::VertexC, F::VertexA) => F::EdgeAC,
+        _ => F::EdgeBC,
+    };
+    match f {
+        F::VertexA => v[0],
+        F::VertexB => v[1],
+        F::VertexC => v[2],
+        F::EdgeAB => edge(v[0], v[1]),
+        F::EdgeAC => edge(v[0], v[2]),
+        F::EdgeBC => edge(v[1], v[2]),
+        other => other,
+    }
+}
+
+/// Ericson's Voronoi-region solve with `a` at the triangle's largest angle; `None` when
+/// the triangle is degenerate (or the face solve is not finite, which only rounding at
+/// the threshold can cause).
+#[inline]
+fn closest_from_largest_angle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<TriangleClosest> {
     let ab = b - a;
     let ac = c - a;
     let n2 = ab.cross(ac).length_squared();
     // Zero-length edges give 0 <= 0; NaN input is degenerate too.
     if n2.is_nan() || n2 <= DEGENERATE_SIN2 * ab.length_squared() * ac.length_squared() {
-        return closest_on_degenerate_triangle(x, a, b, c);
+        return None;
     }
     let ap = x - a;
     let d1 = ab.dot(ap);
     let d2 = ac.dot(ap);
     if d1 <= 0.0 && d2 <= 0.0 {
-        return tri(a, 0.0, 0.0, TriFeature::VertexA);
+        return Some(tri(a, 0.0, 0.0, F::VertexA));
     }
     let bp = x - b;
     let d3 = ab.dot(bp);
     let d4 = ac.dot(bp);
     if d3 >= 0.0 && d4 <= d3 {
-        return tri(b, 1.0, 0.0, TriFeature::VertexB);
+        return Some(tri(b, 1.0, 0.0, F::VertexB));
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
         let v = d1 / (d1 - d3);
-        return tri(a + v * ab, v, 0.0, TriFeature::EdgeAB);
+        return Some(tri(a + v * ab, v, 0.0, F::EdgeAB));
     }
     let cp = x - c;
     let d5 = ab.dot(cp);
     let d6 = ac.dot(cp);
     if d6 >= 0.0 && d5 <= d6 {
-        return tri(c, 0.0, 1.0, TriFeature::VertexC);
+        return Some(tri(c, 0.0, 1.0, F::VertexC));
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
         let w = d2 / (d2 - d6);
-        return tri(a + w * ac, 0.0, w, TriFeature::EdgeAC);
+        return Some(tri(a + w * ac, 0.0, w, F::EdgeAC));
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
         let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return tri(b + w * (c - b), 1.0 - w, w, TriFeature::EdgeBC);
+        return Some(tri(b + w * (c - b), 1.0 - w, w, F::EdgeBC));
     }
     let denom = 1.0 / (va + vb + vc);
     let v = vb * denom;
     let w = vc * denom;
-    tri(a + ab * v + ac * w, v, w, TriFeature::Face)
+    if !(v.is_finite() && w.is_finite()) {
+        return None;
+    }
+    Some(tri(a + ab * v + ac * w, v, w, F::Face))
 }
 
 #[inline]
@@ -177,6 +287,16 @@ pub fn closest_on_box(x: DVec3, min: DVec3, max: DVec3) -> (f64, DVec3) {
 mod tests {
     use super::*;
 
+    /// A fixed-seed LCG, uniform in [-1, 1].
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        }
+    }
+
     fn brute_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
         // Dense barycentric sampling plus exact edges: an upper bound close to the truth.
         let n = 200;
@@ -197,13 +317,7 @@ mod tests {
 
     #[test]
     fn triangle_matches_dense_sampling() {
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+        let mut rnd = uniform(12345);
         for _ in 0..300 {
             let a = DVec3::new(rnd(), rnd(), rnd());
             let b = DVec3::new(rnd(), rnd(), rnd());
@@ -258,6 +372,113 @@ mod tests {
             assert_eq!(rk.feature, r1.feature);
             assert!((rk.point / k - r1.point).length() < 1e-12);
         }
+    }
+
+    /// Issue 10, defect 1: a triangle with one vertex ~2e9 or 5e11 away and two near
+    /// the query was judged degenerate (by the angle at its first vertex) and measured
+    /// by its edges: 0.14 instead of 0.10. The triangles lie in a coordinate plane, so
+    /// the exact distance is known independently: the offset from the plane when the
+    /// query projects inside (with a margin of ~0.05), the distance to the short edge's
+    /// midpoint when it lies behind that edge. Every vertex order and every plane.
+    #[test]
+    fn long_skinny_triangle_regression() {
+        for far in [2e9f32, 5e11] {
+            // Stored in f32, as meshes are.
+            let near0 = glam::Vec3::new(0.0, 0.0, 0.0);
+            let near1 = glam::Vec3::new(0.0, 0.2, 0.0);
+            let distant = glam::Vec3::new(far, 0.1, 0.0);
+            // (query, exact distance, whether the closest point is inside the face)
+            let cases = [
+                (DVec3::new(0.05, 0.1, 0.1), 0.1, true),
+                (DVec3::new(0.05, 0.1, -0.37), 0.37, true),
+                (DVec3::new(-0.3, 0.1, 0.4), 0.5, false),
+            ];
+            let orders = [
+                [0, 1, 2],
+                [0, 2, 1],
+                [1, 0, 2],
+                [1, 2, 0],
+                [2, 0, 1],
+                [2, 1, 0],
+            ];
+            for axes in [[0, 1, 2], [1, 2, 0], [2, 0, 1]] {
+                let permute = |v: DVec3| {
+                    let a = v.to_array();
+                    DVec3::new(a[axes[0]], a[axes[1]], a[axes[2]])
+                };
+                let verts = [near0, near1, distant].map(|v| permute(v.as_dvec3()));
+                for (q, want, on_face) in cases {
+                    let q = permute(q);
+                    for o in orders {
+                        let (a, b, c) = (verts[o[0]], verts[o[1]], verts[o[2]]);
+                        let r = closest_on_triangle(q, a, b, c);
+                        let d = (q - r.point).length();
+                        assert!(
+                            (d - want).abs() <= 1e-12 * want,
+                            "far {far}, axes {axes:?}, order {o:?}: distance {d}, exact {want}, diff {}",
+                            d - want
+                        );
+                        assert_eq!(r.feature == TriFeature::Face, on_face, "order {o:?}");
+                        // The barycentrics reproduce the point to the triangle's scale.
+                        let p = a + r.s * (b - a) + r.t * (c - a);
+                        assert!((p - r.point).length() <= 1e-15 * far as f64 + 1e-12);
+                        assert!(!triangle_is_degenerate(a, b, c));
+                    }
+                }
+            }
+        }
+    }
+
+    /// The rotation to the largest angle must not change the answer: every vertex order
+    /// of a triangle gives the same point, and features and barycentrics that name the
+    /// same vertex, edge or point.
+    #[test]
+    fn vertex_order_does_not_change_the_result() {
+        let mut rnd = uniform(777);
+        for _ in 0..500 {
+            let v = [(); 3].map(|_| DVec3::new(rnd(), rnd(), rnd()));
+            let x = DVec3::new(rnd(), rnd(), rnd()) * 1.5;
+            let base = closest_on_triangle(x, v[0], v[1], v[2]);
+            let weights = |r: &TriangleClosest| [1.0 - r.s - r.t, r.s, r.t];
+            let wb = weights(&base);
+            for o in [[1, 2, 0], [2, 0, 1], [0, 2, 1], [2, 1, 0], [1, 0, 2]] {
+                let r = closest_on_triangle(x, v[o[0]], v[o[1]], v[o[2]]);
+                assert!((r.point - base.point).length() < 1e-12);
+                let w = weights(&r);
+                for k in 0..3 {
+                    assert!(
+                        (w[k] - wb[o[k]]).abs() < 1e-9,
+                        "order {o:?}: {w:?} vs {wb:?}"
+                    );
+                }
+                assert_eq!(
+                    r.feature == TriFeature::Face,
+                    base.feature == TriFeature::Face
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn rotated_features_name_the_caller_vertices() {
+        // Longest edge a-b, so the largest angle is at c and the solve is rotated.
+        let (a, b, c) = (
+            DVec3::ZERO,
+            DVec3::new(4.0, 0.0, 0.0),
+            DVec3::new(2.0, 1.0, 0.0),
+        );
+        let at = |x: DVec3| closest_on_triangle(x, a, b, c);
+        assert_eq!(at(DVec3::new(-1.0, -1.0, 0.0)).feature, TriFeature::VertexA);
+        assert_eq!(at(DVec3::new(5.0, -1.0, 0.0)).feature, TriFeature::VertexB);
+        assert_eq!(at(DVec3::new(2.0, 3.0, 0.0)).feature, TriFeature::VertexC);
+        let r = at(DVec3::new(1.0, -2.0, 0.0));
+        assert_eq!((r.feature, r.s, r.t), (TriFeature::EdgeAB, 0.25, 0.0));
+        let r = at(DVec3::new(0.0, 2.0, 0.0));
+        assert_eq!(r.feature, TriFeature::EdgeAC);
+        assert_eq!(r.s, 0.0);
+        let r = at(DVec3::new(4.0, 2.0, 0.0));
+        assert_eq!(r.feature, TriFeature::EdgeBC);
+        assert!((r.s + r.t - 1.0).abs() < 1e-15);
     }
 
     #[test]

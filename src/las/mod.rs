@@ -82,7 +82,7 @@ fn format_error(path: &Path, message: String) -> MeshError {
 /// Errors name the file: unreadable, not a LAS file, a corrupt or truncated point
 /// stream, an attribute the point format does not have, no point left after filtering.
 pub fn read(path: &Path, options: &LasOptions) -> Result<LasCloud, MeshError> {
-    let file = std::fs::File::open(path).map_err(|source| MeshError::Io {
+    let file = crate::limits::open_input_file(path).map_err(|source| MeshError::Io {
         path: path.to_path_buf(),
         source,
     })?;

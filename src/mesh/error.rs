@@ -29,8 +29,14 @@ pub enum MeshError {
         index: i64,
         count: usize,
     },
-    #[error("{}: vertex {vertex} has a non-finite coordinate (NaN or infinity)", path.display())]
+    #[error("{}: vertex {vertex} (counting from 0) has a non-finite coordinate (NaN, infinity, or a value beyond f32's range of +-3.4e38)", path.display())]
     NonFinite { path: PathBuf, vertex: usize },
+    #[error("{}: vertex {vertex} (counting from 0): coordinate {problem}", path.display())]
+    CoordinateOutOfRange {
+        path: PathBuf,
+        vertex: usize,
+        problem: String,
+    },
     #[error("{}: the mesh has no vertices", path.display())]
     Empty { path: PathBuf },
 }

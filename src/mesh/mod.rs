@@ -9,6 +9,7 @@
 mod error;
 mod obj;
 mod ply;
+mod ply_check;
 mod stl;
 
 pub use error::MeshError;
@@ -83,23 +84,50 @@ impl Aabb {
     }
 }
 
+/// A path's extension in lower case (empty when it has none).
+fn extension(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default()
+}
+
 impl Mesh {
     /// Reads a mesh, choosing the reader by extension (`.obj`, `.ply`, `.stl`, any case).
     /// Lidar files (`.las`, `.laz`) give their points with the default filters (noise
     /// classes dropped), recentred on the header's box centre ([`crate::las`]).
+    /// The path must be a regular file of at most [`crate::limits::MAX_INPUT_BYTES`].
     ///
     /// Errors name the file and what was wrong; a mesh with no vertices is an error.
     pub fn load(path: &Path) -> Result<Mesh, MeshError> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(|e| e.to_ascii_lowercase())
-            .unwrap_or_default();
+        let ext = extension(path);
+        if matches!(ext.as_str(), "las" | "laz") {
+            let mesh = crate::las::read(path, &Default::default())?.mesh;
+            mesh.validate(path)?;
+            return Ok(mesh);
+        }
+        if !matches!(ext.as_str(), "obj" | "ply" | "stl") {
+            return Err(MeshError::UnknownExtension {
+                path: path.to_path_buf(),
+                extension: ext,
+            });
+        }
+        let bytes = crate::limits::read_input_file(path).map_err(|source| MeshError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Mesh::from_bytes(bytes, path)
+    }
+
+    /// Parses a whole mesh file held in memory, choosing the reader by the extension of
+    /// `path` (which is otherwise only used in messages and for the mesh's name), and
+    /// validates it as [`Mesh::load`] does. The fuzz tests feed the readers through this.
+    pub fn from_bytes(bytes: Vec<u8>, path: &Path) -> Result<Mesh, MeshError> {
+        let ext = extension(path);
         let mut mesh = match ext.as_str() {
-            "obj" => obj::read_obj(path)?,
-            "ply" => ply::read_ply(path)?,
-            "stl" => stl::read_stl(path)?,
-            "las" | "laz" => crate::las::read(path, &Default::default())?.mesh,
+            "obj" => obj::parse_obj(&bytes, path)?,
+            "ply" => ply::parse_ply(&bytes, path)?,
+            "stl" => stl::parse_stl(bytes, path)?,
             _ => {
                 return Err(MeshError::UnknownExtension {
                     path: path.to_path_buf(),
@@ -118,7 +146,7 @@ impl Mesh {
     }
 
     /// Checks the invariants every reader and generator must meet: at least one vertex,
-    /// finite coordinates, indices in range.
+    /// finite coordinates within [`crate::limits::MAX_COORD`], indices in range.
     pub fn validate(&self, path: &Path) -> Result<(), MeshError> {
         if self.vertices.is_empty() {
             return Err(MeshError::Empty {
@@ -130,6 +158,17 @@ impl Mesh {
                 path: path.to_path_buf(),
                 vertex: i,
             });
+        }
+        for (i, v) in self.vertices.iter().enumerate() {
+            for c in v.to_array() {
+                if let Some(problem) = crate::limits::coordinate_problem(f64::from(c)) {
+                    return Err(MeshError::CoordinateOutOfRange {
+                        path: path.to_path_buf(),
+                        vertex: i,
+                        problem,
+                    });
+                }
+            }
         }
         let n = self.vertices.len();
         let bad = self

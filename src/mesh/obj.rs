@@ -22,7 +22,8 @@
 //! line continuations, free-form geometry (`curv`, `surf`, ...).
 //!
 //! A file of bare `v` lines is a point cloud: vertices only. Coordinates must be
-//! finite; a malformed, missing or non-finite coordinate is a [`MeshError::Parse`]
+//! finite and within +-1e30 ([`crate::limits::MAX_COORD`]); a malformed, missing,
+//! non-finite or too large coordinate is a [`MeshError::Parse`]
 //! naming the 1-based line.
 //!
 //! The file is read whole and parsed as bytes, without a per-line allocation.
@@ -31,16 +32,8 @@ use super::{Mesh, MeshError};
 use glam::Vec3;
 use std::path::Path;
 
-pub(super) fn read_obj(path: &Path) -> Result<Mesh, MeshError> {
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    parse_obj(&bytes, path)
-}
-
 /// Parses OBJ text held in `bytes`; `path` is only used in errors.
-fn parse_obj(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
+pub(super) fn parse_obj(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let mut mesh = Mesh::default();
     for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
@@ -142,6 +135,9 @@ fn parse_coordinate(token: &[u8]) -> Result<f32, String> {
             "coordinate '{}' in 'v' is not finite (NaN or infinity, or too large for f32)",
             show(token)
         ));
+    }
+    if let Some(problem) = crate::limits::coordinate_problem(f64::from(value)) {
+        return Err(format!("coordinate in 'v': {problem}"));
     }
     Ok(value)
 }

@@ -16,9 +16,11 @@
 //! about 70 ms of that, so there is a single path.)
 //!
 //! Header errors and ASCII payload errors carry the 1-based line ([`MeshError::Parse`]);
-//! binary payload errors (a truncated file) are [`MeshError::Format`].
+//! binary payload errors (a truncated file) are [`MeshError::Format`]. Malformed files
+//! that `ply-rs-bw` would accept (repeated names, a bad `format` line, extra values on
+//! an ASCII line, data after the last element) are rejected by [`super::ply_check`].
 
-use super::{Mesh, MeshError};
+use super::{Mesh, MeshError, ply_check};
 use glam::Vec3;
 use ply_rs_bw::parser::{ParseError, Parser, Reader};
 use ply_rs_bw::ply::{
@@ -26,21 +28,13 @@ use ply_rs_bw::ply::{
 };
 use std::path::Path;
 
-pub(super) fn read_ply(path: &Path) -> Result<Mesh, MeshError> {
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    parse_ply(&bytes, path)
-}
-
 /// Names of the face list property we accept (a face element with both is rejected).
 const FACE_LIST_NAMES: [&str; 2] = ["vertex_indices", "vertex_index"];
 
 /// Parses a whole PLY file held in `bytes`; `path` is only used in errors. (Reading the
 /// file whole was measured faster than streaming it through a `BufReader`, at the cost
 /// of holding the file and the vertices at once: about 200 MB for 8 M points.)
-fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
+pub(super) fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
     let format_err = |message: String| MeshError::Format {
         path: path.to_path_buf(),
         message,
@@ -55,11 +49,15 @@ fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
             "not a PLY file (it does not start with 'ply')".into(),
         ));
     }
+    let checked = ply_check::check_header(bytes, path)?;
     let mut reader = Reader::new(bytes);
     let header = Parser::<Skip>::new()
         .read_header(&mut reader)
         .map_err(|e| wrap(path, e, true, "invalid PLY header"))?;
     check_layout(&header).map_err(format_err)?;
+    if let Some(info) = checked.as_ref().filter(|i| i.ascii) {
+        ply_check::check_ascii_lines(bytes, info, path)?;
+    }
 
     let ascii = header.encoding == Encoding::Ascii;
     let mut mesh = Mesh::default();
@@ -94,6 +92,7 @@ fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
             }
         }
     }
+    ply_check::check_trailing(bytes, reader.get_ref(), ascii, path)?;
     // Elements may come in any order, so indices are converted once all are read.
     let count = mesh.vertices.len();
     mesh.triangles = triangulate(&faces, count, path)?;

@@ -19,15 +19,7 @@ use std::collections::HashMap;
 use std::io::Cursor;
 use std::path::Path;
 
-pub(super) fn read_stl(path: &Path) -> Result<Mesh, MeshError> {
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    parse_stl(bytes, path)
-}
-
-fn parse_stl(mut bytes: Vec<u8>, path: &Path) -> Result<Mesh, MeshError> {
+pub(super) fn parse_stl(mut bytes: Vec<u8>, path: &Path) -> Result<Mesh, MeshError> {
     if bytes.is_empty() {
         return Err(MeshError::Empty {
             path: path.to_path_buf(),
@@ -40,6 +32,17 @@ fn parse_stl(mut bytes: Vec<u8>, path: &Path) -> Result<Mesh, MeshError> {
     let binary_count = binary_triangle_count(&bytes);
     let ascii = bytes.starts_with(b"solid") && !matches!(binary_count, Some((_, true)));
     if ascii {
+        if let Err(e) = std::str::from_utf8(&bytes) {
+            let at = e.valid_up_to();
+            return Err(MeshError::Parse {
+                path: path.to_path_buf(),
+                line: 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count(),
+                message: format!(
+                    "invalid UTF-8 at byte {at}: an ASCII STL must be text (or a binary STL \
+                     of exactly 84 + 50 n bytes)"
+                ),
+            });
+        }
         if matches!(bytes.get(5), None | Some(b'\n' | b'\r')) {
             // "solid\n" or "solid\r\n": stl_io wants "solid " before the name.
             bytes.splice(5..5, *b" ");

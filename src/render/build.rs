@@ -113,6 +113,13 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
         };
         if !obj.transform.is_identity() {
             obj.transform.apply_to_mesh(&mut mesh);
+            // The transform may carry coordinates past the limits (crate::limits).
+            mesh.validate(std::path::Path::new(&mesh.name))
+                .map_err(|source| BuildError::Mesh {
+                    scene: name.clone(),
+                    object: k,
+                    source,
+                })?;
         }
         steps.push(BuildStep {
             object: k,
@@ -142,10 +149,14 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
                 "max_alpha_rel needs a non-zero bounding box (diagonal {diag})"
             ))
         })?;
-        if !(alpha > 0.0 && alpha.is_finite() && max_alpha > 0.0 && max_alpha.is_finite()) {
-            return Err(invalid(format!(
-                "alpha ({alpha}) and max_alpha ({max_alpha}) must be positive and finite"
-            )));
+        for (key, v) in [("alpha", alpha), ("max_alpha", max_alpha)] {
+            if let Some(problem) = crate::limits::alpha_problem(v) {
+                return Err(invalid(format!(
+                    "{key} {problem} (resolved from {} = {} over the diagonal {diag})",
+                    obj.alpha.key(),
+                    obj.alpha.value()
+                )));
+            }
         }
         let mut sets = Vec::new();
         for &kind in &obj.primitives {

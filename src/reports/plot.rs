@@ -37,17 +37,18 @@ const COLOURS: [RGBColor; 6] = [
     RGBColor(23, 190, 207),
 ];
 
-/// Writes an RGB buffer as PNG (plotters' bitmap backend draws into memory; the `image`
-/// crate encodes).
+/// Writes an RGB buffer as PNG, JPEG or WebP (plotters' bitmap backend draws into
+/// memory; [`crate::output`] encodes and writes through a temporary file).
 fn save(path: &Path, width: u32, height: u32, buf: Vec<u8>) -> Result<(), PlotError> {
-    let img = image::RgbImage::from_raw(width, height, buf).ok_or_else(|| PlotError {
+    let err = |message: String| PlotError {
         path: path.display().to_string(),
-        message: "buffer size".into(),
-    })?;
-    img.save(path).map_err(|e| PlotError {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })
+        message,
+    };
+    let img =
+        image::RgbImage::from_raw(width, height, buf).ok_or_else(|| err("buffer size".into()))?;
+    crate::output::Output::check(path, crate::output::IMAGE_8BIT, "a plot")
+        .and_then(|out| out.write_image(&image::DynamicImage::ImageRgb8(img)))
+        .map_err(|e| err(e.to_string()))
 }
 
 /// One curve of the render sweep: `(beta, seconds, mean error, p95 error)` per beta,

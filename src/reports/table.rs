@@ -2,6 +2,7 @@
 //! CSV (full precision, one header line of column names) and JSON (an array of objects
 //! keyed by column name). Column meanings and units are documented in `doc/reports.md`.
 
+use crate::output::{Kind, Output, OutputError};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -222,17 +223,29 @@ impl Table {
         )
     }
 
-    pub fn write_csv(&self, path: &Path) -> std::io::Result<()> {
+    pub fn write_csv(&self, path: &Path) -> Result<(), OutputError> {
         write_file(path, &self.to_csv())
     }
 }
 
-/// Writes `text` to `path`, creating the parent directory.
-pub fn write_file(path: &Path, text: &str) -> std::io::Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)?;
+/// Creates the parent folder of an output path if it is missing (the reports write
+/// into `renders/...` folders that may not exist yet).
+pub fn create_parent(path: &Path) -> Result<(), OutputError> {
+    match path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        Some(dir) => std::fs::create_dir_all(dir).map_err(|source| OutputError::Folder {
+            path: path.to_path_buf(),
+            folder: dir.to_path_buf(),
+            source,
+        }),
+        None => Ok(()),
     }
-    std::fs::write(path, text)
+}
+
+/// Writes `text` to `path` (creating the parent folder) through a temporary file
+/// renamed on success ([`crate::output`]).
+pub fn write_file(path: &Path, text: &str) -> Result<(), OutputError> {
+    create_parent(path)?;
+    Output::check_as(path, Kind::Csv)?.write_bytes(text.as_bytes())
 }
 
 #[cfg(test)]

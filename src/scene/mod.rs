@@ -238,9 +238,19 @@ impl Scene {
     /// Reads, parses and validates a scene file. A missing or unreadable file is an error
     /// naming it.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+        let read_err = |source| SceneError::Read {
             path: path.to_path_buf(),
             source,
+        };
+        let bytes = crate::limits::read_input_file(path).map_err(read_err)?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            read_err(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!(
+                    "not UTF-8 text (invalid byte at offset {}); a scene file is TOML",
+                    e.utf8_error().valid_up_to()
+                ),
+            ))
         })?;
         Scene::from_str(&text, path)
     }

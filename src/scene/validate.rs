@@ -286,7 +286,17 @@ impl Checker<'_> {
     /// `prefix` is `""` for alpha and `"max_"` for max_alpha.
     fn alpha(&self, name: &str, prefix: &str, alpha: AlphaSpec) -> Result<(), SceneError> {
         let field = format!("{name}.{prefix}{}", alpha.key());
-        match positive_error(&field, alpha.value()) {
+        let problem = positive_error(&field, alpha.value()).or_else(|| {
+            // The limits apply to absolute alphas; a relative one is checked once the
+            // object's diagonal is known (render::build).
+            match alpha {
+                AlphaSpec::Absolute(v) => {
+                    crate::limits::alpha_problem(v).map(|p| format!("{field} {p}"))
+                }
+                AlphaSpec::Relative(_) => None,
+            }
+        });
+        match problem {
             Some(message) => Err(self.fail(&field, &alpha.value(), message)),
             None => Ok(()),
         }

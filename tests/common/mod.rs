@@ -121,3 +121,28 @@ pub fn angle(a: DVec3, b: DVec3) -> f64 {
     }
     (a.dot(b) / (la * lb)).clamp(-1.0, 1.0).acos()
 }
+
+/// Runs a command (the built binary) in `dir` with `args`, feeding `stdin` (ignoring a
+/// broken pipe: the process may exit before reading bad input), and collects its output.
+pub fn run_cli(
+    mut cmd: std::process::Command,
+    args: &[&str],
+    dir: &std::path::Path,
+    stdin: Option<&str>,
+) -> std::process::Output {
+    use std::io::Write;
+    use std::process::Stdio;
+    let mut child = cmd
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    if let Some(s) = stdin {
+        let _ = child.stdin.take().unwrap().write_all(s.as_bytes());
+    }
+    drop(child.stdin.take());
+    child.wait_with_output().unwrap()
+}

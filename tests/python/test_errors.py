@@ -94,7 +94,7 @@ def test_bad_parameters(mesh, kwargs, match):
 
 
 def test_alpha_rel_of_a_single_point():
-    with pytest.raises(ValueError, match="alpha_rel needs a mesh with a non-zero bounding box; give alpha"):
+    with pytest.raises(ValueError, match="alpha_rel needs a mesh with a non-zero bounding box"):
         st.SmoothDistance([[1.0, 2.0, 3.0]], alpha_rel=10)
 
 
