@@ -176,7 +176,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
 /// The one-line summary printed after a render.
 pub fn summary(scene: &Path, st: &ImageStats, output: &Path) -> String {
     format!(
-        "{}: {}x{} in {:.3} s on {} threads ({:.0} rays/s), {:.2} evaluations/ray ({:.2} per hit ray, max {}) + {:.2} coarse, {:.1} leaves/evaluation, {:.0} leaves/ray, {:.1}% hits -> {}",
+        "{}: {}x{} in {:.3} s on {} threads ({:.0} rays/s), {:.2} evaluations/ray ({:.2} per hit ray, max {}) + {:.2} bound steps ({:.2} per hit ray + {:.2} per ray on tiles), {:.1} leaves/evaluation, {:.0} leaves/ray, {:.1}% hits -> {}",
         scene.display(),
         st.width,
         st.height,
@@ -186,7 +186,9 @@ pub fn summary(scene: &Path, st: &ImageStats, output: &Path) -> String {
         st.evals_per_ray(),
         st.evals_per_hit(),
         st.max_evals_per_ray,
-        st.coarse_evals as f64 / st.rays.max(1) as f64,
+        st.bound_evals_per_ray(),
+        st.bound_evals_per_hit(),
+        st.tile_evals_per_ray(),
         st.leaves_per_eval(),
         st.leaves_per_ray(),
         100.0 * st.hits as f64 / st.rays.max(1) as f64,
@@ -200,12 +202,37 @@ fn write_stats_json(out: &Output, scene: &Path, st: &ImageStats, built: &BuiltSc
         "image": st,
         "evals_per_ray": st.evals_per_ray(),
         "evals_per_hit_ray": st.evals_per_hit(),
+        "bound_evals_per_ray": st.bound_evals_per_ray(),
+        "bound_evals_per_hit_ray": st.bound_evals_per_hit(),
+        "tile_evals_per_ray": st.tile_evals_per_ray(),
         "leaves_per_eval": st.leaves_per_eval(),
+        "leaves_per_ray": st.leaves_per_ray(),
+        "leaves_per_hit_ray": st.leaves_per_hit(),
+        "phases": phases(st, built),
         "rays_per_second": st.rays_per_second(),
         "epsilon": built.epsilon,
         "build": built.steps,
     });
     Ok(out.write_bytes(serde_json::to_string_pretty(&json)?.as_bytes())?)
+}
+
+/// Seconds per phase: loading meshes (the build log's `mesh` steps), building the rest
+/// (primitive sets, BVHs, colours, MatCaps), tracing (wall clock of the image loop,
+/// shading included) and shading alone (CPU seconds summed over the threads).
+fn phases(st: &ImageStats, built: &BuiltScene) -> serde_json::Value {
+    let load: f64 = built
+        .steps
+        .iter()
+        .filter(|s| s.what.starts_with("mesh "))
+        .map(|s| s.seconds)
+        .sum();
+    let all: f64 = built.steps.iter().map(|s| s.seconds).sum();
+    serde_json::json!({
+        "load": load,
+        "build": all - load,
+        "trace": st.seconds,
+        "shade_cpu": st.shade_cpu_seconds,
+    })
 }
 
 fn write_depth_exr(out: &Output, r: &Rendered) -> Result<()> {

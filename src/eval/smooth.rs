@@ -44,9 +44,6 @@ pub struct EvalParams {
     /// (`PRUNE_TOLERANCE` by default); `s` stays a lower bound of the exact value and
     /// within `2 prune_tolerance / alpha` of it.
     pub prune_tolerance: f64,
-    /// Far-field terms from the node's centroid and spread as well as its box
-    /// (`primitives::moments`, default on); off, the box alone (the paper's term).
-    pub tight_far_field: bool,
 }
 
 impl EvalParams {
@@ -58,7 +55,6 @@ impl EvalParams {
             accumulation: Accumulation::Stable,
             prune: true,
             prune_tolerance: PRUNE_TOLERANCE,
-            tight_far_field: true,
         }
     }
 }
@@ -199,19 +195,10 @@ fn traverse<P: Primitive, const GRAD: bool>(
         }
         let diam = node.diam as f64;
         if p.beta > 0.0 && diam * diam < beta2 * r2 {
-            let r_box = r2.sqrt();
-            // The centroid bound can only win for nodes of moderate size against 1/alpha
-            // (see `primitives::moments`): below, the box bound loses little; above,
-            // the exponential of the node's extent swamps the spread term.
-            let a_diam = p.alpha * diam;
-            let r = if p.tight_far_field && (0.25..=6.0).contains(&a_diam) {
-                set.moments[i as usize].far_distance(node, x, r_box, p.alpha)
-            } else {
-                r_box
-            };
+            let r = r2.sqrt();
             if GRAD {
                 let (_, c) = node.distance(x);
-                acc.add(r, node.size as f64 * w_ff, (x - c) / r_box, DVec3::ZERO);
+                acc.add(r, node.size as f64 * w_ff, (x - c) / r, DVec3::ZERO);
             } else {
                 acc.add_value(r, node.size as f64 * w_ff);
             }

@@ -26,9 +26,6 @@ pub struct Term {
 pub trait Primitive: Copy + Send + Sync + 'static {
     fn bounds(&self) -> Aabb;
     fn centroid(&self) -> Vec3;
-    /// Largest distance from the centroid to the primitive's vertices (0 for a point),
-    /// in f64 from the f32 vertices.
-    fn radius(&self) -> f64;
     fn closest_point(&self, x: DVec3) -> DVec3;
     /// The full term, with the direction and the weight gradient.
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term;
@@ -56,9 +53,6 @@ impl Primitive for Point {
     }
     fn centroid(&self) -> Vec3 {
         self.p
-    }
-    fn radius(&self) -> f64 {
-        0.0
     }
     fn closest_point(&self, _x: DVec3) -> DVec3 {
         self.p.as_dvec3()
@@ -99,11 +93,6 @@ impl Primitive for Edge {
     }
     fn centroid(&self) -> Vec3 {
         0.5 * (self.a + self.b)
-    }
-    fn radius(&self) -> f64 {
-        let m = self.centroid().as_dvec3();
-        m.distance(self.a.as_dvec3())
-            .max(m.distance(self.b.as_dvec3()))
     }
     fn closest_point(&self, x: DVec3) -> DVec3 {
         closest_on_segment(x, self.a.as_dvec3(), self.b.as_dvec3()).point
@@ -163,13 +152,6 @@ impl Primitive for Triangle {
     }
     fn centroid(&self) -> Vec3 {
         (self.a + self.b + self.c) / 3.0
-    }
-    fn radius(&self) -> f64 {
-        let m = self.centroid().as_dvec3();
-        [self.a, self.b, self.c]
-            .iter()
-            .map(|v| m.distance(v.as_dvec3()))
-            .fold(0.0, f64::max)
     }
     fn closest_point(&self, x: DVec3) -> DVec3 {
         closest_on_triangle(x, self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3()).point

@@ -4,7 +4,6 @@
 use serde::Deserialize;
 
 mod kinds;
-pub mod moments;
 mod sets;
 pub mod weights;
 

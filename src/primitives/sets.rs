@@ -3,7 +3,6 @@
 
 use super::PrimitiveKind;
 use super::kinds::{Edge, Point, Primitive, Triangle};
-use super::moments::{NodeMoments, node_moments};
 use crate::bvh::{self, BuildOptions, Bvh};
 use crate::mesh::{Aabb, Mesh};
 use rayon::prelude::*;
@@ -33,8 +32,6 @@ pub struct PrimitiveSet<P> {
     /// Primitives in leaf order; `bvh.order[i]` is the source index of `prims[i]`.
     pub prims: Vec<P>,
     pub bvh: Bvh,
-    /// Per-node centroid and spread for the far-field term (indexed like `bvh.nodes`).
-    pub moments: Vec<NodeMoments>,
     /// Largest valence (SPEC 1); 1 for points.
     pub max_adj: f64,
     pub bounds: Aabb,
@@ -50,8 +47,6 @@ impl<P: Primitive> PrimitiveSet<P> {
         let bvh = bvh::build(&bounds, &centroids, options);
         drop((bounds, centroids));
         let sorted: Vec<P> = bvh.order.par_iter().map(|&i| prims[i as usize]).collect();
-        drop(prims);
-        let moments = node_moments(&bvh.nodes, &sorted);
         let bounds = bvh
             .nodes
             .first()
@@ -63,7 +58,6 @@ impl<P: Primitive> PrimitiveSet<P> {
         PrimitiveSet {
             prims: sorted,
             bvh,
-            moments,
             max_adj,
             bounds,
             times: BuildTimes {
@@ -172,9 +166,7 @@ impl AnySet {
 
     /// Approximate heap memory of the set (primitives and BVH), bytes.
     pub fn memory_bytes(&self) -> usize {
-        with_set!(self, s => std::mem::size_of_val(s.prims.as_slice())
-            + std::mem::size_of_val(s.moments.as_slice())
-            + s.bvh.memory_bytes())
+        with_set!(self, s => std::mem::size_of_val(s.prims.as_slice()) + s.bvh.memory_bytes())
     }
 }
 

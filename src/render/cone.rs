@@ -113,9 +113,8 @@ fn march(
         .iter()
         .map(|&d| (d - axis).length())
         .fold(0.0, f64::max);
-    // The tile's rays enter the grown scene box no earlier than the earliest corner
-    // does... which need not hold for interior rays, so start from the camera's own
-    // clearance and let the march skip the empty space.
+    // Start from the camera's own clearance (every ray's start) and let the march skip
+    // the empty space before the scene box.
     let mut t = t_start;
     let t_far = tracer.farthest(o);
     let beta = tracer.options().coarse_beta;

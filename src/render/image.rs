@@ -48,6 +48,8 @@ pub struct ImageStats {
     /// Bound evaluations on tile axes (cone marching), shared by the tile's rays;
     /// included in `coarse_evals` and their leaves in `leaves` and `coarse_leaves`.
     pub tile_evals: u64,
+    /// CPU seconds spent shading hits (summed over threads; part of `seconds`' work).
+    pub shade_cpu_seconds: f64,
     /// Wall-clock seconds of the tracing loop.
     pub seconds: f64,
     pub threads: usize,
@@ -93,6 +95,7 @@ impl ImageStats {
         self.falloffs += o.falloffs;
         self.backtracks += o.backtracks;
         self.tile_evals += o.tile_evals;
+        self.shade_cpu_seconds += o.shade_cpu_seconds;
     }
 
     /// Adds the shared work of tile marches.
@@ -107,8 +110,26 @@ impl ImageStats {
     pub fn evals_per_ray(&self) -> f64 {
         self.evals as f64 / self.rays.max(1) as f64
     }
+    /// Full-accuracy evaluations per ray that hit.
     pub fn evals_per_hit(&self) -> f64 {
         self.hit_evals as f64 / self.hits.max(1) as f64
+    }
+    /// Bound steps (coarse evaluations) per ray that hit, its own only: the tile
+    /// marches it shared are counted in [`ImageStats::tile_evals_per_ray`].
+    pub fn bound_evals_per_hit(&self) -> f64 {
+        self.hit_coarse_evals as f64 / self.hits.max(1) as f64
+    }
+    /// Bound steps per ray, the tile marches included.
+    pub fn bound_evals_per_ray(&self) -> f64 {
+        self.coarse_evals as f64 / self.rays.max(1) as f64
+    }
+    /// Tile-march evaluations per ray (each shared by a tile's rays).
+    pub fn tile_evals_per_ray(&self) -> f64 {
+        self.tile_evals as f64 / self.rays.max(1) as f64
+    }
+    /// Leaves visited per ray that hit, its own evaluations only.
+    pub fn leaves_per_hit(&self) -> f64 {
+        self.hit_leaves as f64 / self.hits.max(1) as f64
     }
     /// Leaves per evaluation, coarse and fine together.
     pub fn leaves_per_eval(&self) -> f64 {
@@ -198,6 +219,7 @@ pub fn render(
                 &mut |px, py, r| {
                     tile_stats.tally(&r);
                     if let Some(hit) = r.hit {
+                        let shading = Instant::now();
                         let i = ((py - tile.y0) * tile.w + (px - tile.x0)) as usize;
                         let n = camera.to_camera_space(hit.normal);
                         let shaded = shaders
@@ -206,6 +228,7 @@ pub fn render(
                             .unwrap_or([255, 0, 255]);
                         colours[i] = super::albedo::shade_hit(tracer.objects(), &hit, shaded);
                         tile_depth[i] = hit.t as f32;
+                        tile_stats.shade_cpu_seconds += shading.elapsed().as_secs_f64();
                     }
                 },
             );

@@ -75,9 +75,6 @@ impl TraceObject {
         p.prune_tolerance = p.prune_tolerance.max(prune_tolerance);
         if let Some(b) = beta {
             p.beta = b.max(p.beta);
-            // At a coarse beta the far nodes are large against 1/alpha, where the
-            // centroid bound almost never beats the box one: not worth its cost there.
-            p.tight_far_field = false;
         }
         if grad {
             eval::evaluate(sets, x, &p)

@@ -12,10 +12,12 @@ pub struct DepthDiff {
     pub both: usize,
     /// Rays that hit in exactly one of them.
     pub only_one: usize,
-    /// `|t_a - t_b|` over the rays that hit in both, divided by `length`: mean, 95th
-    /// percentile and maximum (`None` when no ray hit in both).
+    /// `|t_a - t_b|` over the rays that hit in both, divided by `length`: mean, median,
+    /// 95th and 99th percentiles and maximum (`None` when no ray hit in both).
     pub mean: Option<f64>,
+    pub p50: Option<f64>,
     pub p95: Option<f64>,
+    pub p99: Option<f64>,
     pub max: Option<f64>,
 }
 
@@ -48,7 +50,9 @@ pub fn compare_depths(a: &[f32], b: &[f32], b_scale: f64, length: f64) -> DepthD
         both,
         only_one,
         mean,
+        p50: quantile(&mut errs, 0.5),
         p95: quantile(&mut errs, 0.95),
+        p99: quantile(&mut errs, 0.99),
         max,
     }
 }

@@ -198,7 +198,6 @@ pub fn run(
                         Accumulation::Stable
                     };
                     obj.params.prune = !o.paper_mode;
-                    obj.params.tight_far_field = !o.paper_mode;
                 }
                 let options = if o.paper_mode {
                     TracerOptions::paper(built.epsilon, scene.render.max_steps)
@@ -312,7 +311,9 @@ pub fn table(rows: &[SweepRow]) -> Table {
         ("speedup", "speedup"),
         ("reference", "vs"),
         ("error_mean", "err mean"),
+        ("error_p50", "err p50"),
         ("error_p95", "err p95"),
+        ("error_p99", "err p99"),
         ("error_max", "err max"),
         ("only_one_percent", "1-sided %"),
         ("evals_per_ray", "evals/ray"),
@@ -336,7 +337,9 @@ pub fn table(rows: &[SweepRow]) -> Table {
             Cell::num(r.speedup, 2),
             Cell::text(r.reference),
             Cell::sci(r.depth.mean),
+            Cell::sci(r.depth.p50),
             Cell::sci(r.depth.p95),
+            Cell::sci(r.depth.p99),
             Cell::sci(r.depth.max),
             Cell::num(r.depth.only_one_percent(), 3),
             Cell::num(r.evals_per_ray, 2),
