@@ -59,21 +59,6 @@ pub struct Bvh {
 }
 
 impl Bvh {
-    /// The children of inner node `i` with their squared box distances to `x`, farther
-    /// first: pushed in this order on a stack, the nearer one is popped next (the
-    /// near-to-far order the traversals rely on).
-    #[inline]
-    pub fn children_far_near(&self, i: u32, x: DVec3) -> [(u32, f64); 2] {
-        let (l, r) = (i + 1, self.nodes[i as usize].index);
-        let dl = self.nodes[l as usize].distance_squared(x);
-        let dr = self.nodes[r as usize].distance_squared(x);
-        if dl <= dr {
-            [(r, dr), (l, dl)]
-        } else {
-            [(l, dl), (r, dr)]
-        }
-    }
-
     pub fn root(&self) -> &Node {
         &self.nodes[0]
     }

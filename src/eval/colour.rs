@@ -131,8 +131,17 @@ fn traverse<P: Primitive>(
             acc.add(r2.sqrt(), node.size as f64 * w_ff, cols.nodes[i as usize]);
             continue;
         }
+        let (l, rr) = (i + 1, node.index);
+        let dl = nodes[l as usize].distance_squared(x);
+        let dr = nodes[rr as usize].distance_squared(x);
+        let (first, second) = if dl <= dr {
+            ((rr, dr), (l, dl))
+        } else {
+            ((l, dl), (rr, dr))
+        };
         debug_assert!(top + 2 <= STACK);
-        stack[top..top + 2].copy_from_slice(&set.bvh.children_far_near(i, x));
+        stack[top] = first;
+        stack[top + 1] = second;
         top += 2;
     }
 }

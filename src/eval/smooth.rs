@@ -205,8 +205,18 @@ fn traverse<P: Primitive, const GRAD: bool>(
             stats.far += 1;
             continue;
         }
+        let (l, rr) = (i + 1, node.index);
+        let dl = nodes[l as usize].distance_squared(x);
+        let dr = nodes[rr as usize].distance_squared(x);
+        // Push the farther child first so the nearer one is popped next.
+        let (first, second) = if dl <= dr {
+            ((rr, dr), (l, dl))
+        } else {
+            ((l, dl), (rr, dr))
+        };
         debug_assert!(top + 2 <= STACK);
-        stack[top..top + 2].copy_from_slice(&set.bvh.children_far_near(i, x));
+        stack[top] = first;
+        stack[top + 1] = second;
         top += 2;
     }
 }
