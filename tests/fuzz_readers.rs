@@ -13,7 +13,7 @@
 //!   must give exactly the brute-force decoding of the flipped floats, or an error when
 //!   one is not finite or beyond the coordinate limit.
 //! - Random bytes to each reader and to the scene loader: no panic.
-//! - LAS/LAZ: see the marked place at the end (the readers are being written).
+//! - LAS/LAZ: mutated copies of the small files in `data/las/`, read through `Mesh::load`.
 //!
 //! Budget: `SMOOTHTRACE_FUZZ_CASES` cases per property (default 1000, a few seconds in
 //! release; 5000 took 18 s on the project machine). The long run: `SMOOTHTRACE_FUZZ_CASES=100000 cargo test --release --test
@@ -690,10 +690,56 @@ proptest! {
 }
 
 // ---------------------------------------------------------------------------------
-// LAS/LAZ: RESERVED. The LAS/LAZ readers are being written on another branch; once
-// they exist, add here (1) generated point records written with the `las` crate's
-// writer read back exactly (after scale and offset), (2) mutated files and slices of
-// `data/las/` that give an error naming the file or points meeting `check_outcome`,
-// (3) random bytes behind a `LASF` signature. Feed them through the same entry point
-// as the mesh readers (`Mesh::from_bytes` with a `.las`/`.laz` name) if the reader
-// joins it.
+// LAS/LAZ: mutated copies of the small files in `data/las/` (a LAS 1.2 file of 100
+// points and a small LAZ), read through `Mesh::load` from a temporary file (the lidar
+// reader streams from a file): no panic, and either an error naming the file or points
+// meeting `check_outcome`. A tenth of the other properties' cases: each one writes and
+// reads a file. (Corrupt and truncated real files are also in tests/las.rs.)
+
+fn las_seed(name: &str) -> Option<Vec<u8>> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data/las")
+        .join(name);
+    std::fs::read(path).ok()
+}
+
+fn fuzz_lidar(name: &str, ext: &str, muts: &[Mutation]) {
+    let Some(mut bytes) = las_seed(name) else {
+        return;
+    };
+    for m in muts {
+        apply(&mut bytes, m);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(format!("fuzzed.{ext}"));
+    std::fs::write(&path, &bytes).unwrap();
+    check_outcome(&Mesh::load(&path), &path);
+}
+
+#[test]
+fn lidar_seeds_are_present_or_the_skip_says_why() {
+    if las_seed("100-points.las").is_none() {
+        eprintln!(
+            "skipping the LAS/LAZ fuzzing: data/las/ is absent (link ../shared/data to data)"
+        );
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: (cases() / 10).max(20), ..config() })]
+
+    #[test]
+    fn mutated_las_never_panics(muts in proptest::collection::vec(mutation(), 1..4)) {
+        fuzz_lidar("100-points.las", "las", &muts);
+    }
+
+    // Found by this property on its first run: a mutated LAZ file makes the laz decoder
+    // allocate without bound and the process aborts (memory allocation failure), so it
+    // cannot run in the suite until the LAS reader bounds what a header may ask for.
+    // Reproduce with `cargo test --release --test fuzz_readers -- --ignored`.
+    #[test]
+    #[ignore = "aborts: a mutated LAZ header makes the decoder allocate without bound (issue 12)"]
+    fn mutated_laz_never_panics(muts in proptest::collection::vec(mutation(), 1..4)) {
+        fuzz_lidar("simple.laz", "laz", &muts);
+    }
+}
