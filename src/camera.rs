@@ -138,8 +138,15 @@ impl Camera {
     /// The ray through the centre of pixel `(px, py)` (row 0 at the top): origin and unit
     /// direction. Pixels outside the image give rays outside the field of view; no panic.
     pub fn ray(&self, px: u32, py: u32) -> (DVec3, DVec3) {
-        let sx = 2.0 * (f64::from(px) + 0.5) / f64::from(self.width) - 1.0;
-        let sy = 1.0 - 2.0 * (f64::from(py) + 0.5) / f64::from(self.height);
+        self.ray_through(f64::from(px) + 0.5, f64::from(py) + 0.5)
+    }
+
+    /// The ray through the image-plane position `(x, y)` in pixel units (`(0, 0)` is the
+    /// top-left corner of the image, `(px + 0.5, py + 0.5)` the centre of pixel `(px, py)`):
+    /// sub-pixel samples for anti-aliasing.
+    pub fn ray_through(&self, x: f64, y: f64) -> (DVec3, DVec3) {
+        let sx = 2.0 * x / f64::from(self.width) - 1.0;
+        let sy = 1.0 - 2.0 * y / f64::from(self.height);
         let x = sx * self.half_height * self.aspect();
         let y = sy * self.half_height;
         let d = self.forward + x * self.right + y * self.up_cam;

@@ -69,12 +69,17 @@ impl Tile {
 }
 
 /// Traces every pixel of `tile`, starting at `t_start` (the camera's own clearance), and
-/// calls `out(px, py, result)` for each. With `cone = false` every ray is traced on its
-/// own (the reference the cone march must reproduce).
+/// calls `out(px, py, result)` for each. The ray of pixel `(px, py)` passes through the
+/// image-plane point `(px + sub[0], py + sub[1])` (`[0.5, 0.5]`: pixel centres; other
+/// offsets in `[0, 1)` give one sub-pixel sample per pixel for anti-aliasing, the cone
+/// built from the same rays). With `cone = false` every ray is traced on its own (the
+/// reference the cone march must reproduce).
+#[allow(clippy::too_many_arguments)]
 pub fn trace_tile(
     tracer: &Tracer,
     camera: &Camera,
     tile: Tile,
+    sub: [f64; 2],
     t_start: f64,
     cone: bool,
     stats: &mut ConeStats,
@@ -83,30 +88,36 @@ pub fn trace_tile(
     if !cone || tracer.options().coarse_beta <= 0.0 {
         for py in tile.y0..tile.y0 + tile.h {
             for px in tile.x0..tile.x0 + tile.w {
-                let (o, d) = camera.ray(px, py);
+                let (o, d) = ray(camera, px, py, sub);
                 out(px, py, tracer.trace(o, d, t_start));
             }
         }
         return;
     }
-    march(tracer, camera, tile, t_start, stats, out);
+    march(tracer, camera, tile, sub, t_start, stats, out);
+}
+
+/// The ray of pixel `(px, py)` through its sub-pixel position `sub`.
+fn ray(camera: &Camera, px: u32, py: u32, sub: [f64; 2]) -> (DVec3, DVec3) {
+    camera.ray_through(f64::from(px) + sub[0], f64::from(py) + sub[1])
 }
 
 fn march(
     tracer: &Tracer,
     camera: &Camera,
     tile: Tile,
+    sub: [f64; 2],
     t_start: f64,
     stats: &mut ConeStats,
     out: &mut dyn FnMut(u32, u32, RayResult),
 ) {
     if tile.w < MIN_TILE || tile.h < MIN_TILE {
-        return trace_tile(tracer, camera, tile, t_start, false, stats, out);
+        return trace_tile(tracer, camera, tile, sub, t_start, false, stats, out);
     }
-    let (o, _) = camera.ray(tile.x0, tile.y0);
+    let (o, _) = ray(camera, tile.x0, tile.y0, sub);
     let (x1, y1) = (tile.x0 + tile.w - 1, tile.y0 + tile.h - 1);
     let corners = [(tile.x0, tile.y0), (x1, tile.y0), (tile.x0, y1), (x1, y1)]
-        .map(|(px, py)| camera.ray(px, py).1);
+        .map(|(px, py)| ray(camera, px, py, sub).1);
     let axis = corners.iter().copied().sum::<DVec3>().normalize();
     // |d_i - a| for the widest ray: the cone radius per unit of t.
     let spread = corners
@@ -142,9 +153,9 @@ fn march(
         return;
     }
     if !advanced && tile.w <= 2 * MIN_TILE && tile.h <= 2 * MIN_TILE {
-        return trace_tile(tracer, camera, tile, t, false, stats, out);
+        return trace_tile(tracer, camera, tile, sub, t, false, stats, out);
     }
     for q in tile.quarters() {
-        march(tracer, camera, q, t, stats, out);
+        march(tracer, camera, q, sub, t, stats, out);
     }
 }

@@ -213,6 +213,7 @@ pub fn render(
                 tracer,
                 camera,
                 tile,
+                [0.5, 0.5],
                 s0,
                 cone,
                 &mut cones,
