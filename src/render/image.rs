@@ -163,6 +163,20 @@ pub fn render(
     background: [u8; 3],
     progress: &(dyn Fn(u64) + Sync),
 ) -> Rendered {
+    render_cancellable(tracer, camera, shaders, background, progress, &|| false)
+        .expect("a render that is never cancelled finishes")
+}
+
+/// [`render`] that gives up when `cancelled()` turns true (checked before each tile):
+/// `None` then. An interactive view calls it with a check of its newest request.
+pub fn render_cancellable(
+    tracer: &Tracer,
+    camera: &Camera,
+    shaders: &[MatCap],
+    background: [u8; 3],
+    progress: &(dyn Fn(u64) + Sync),
+    cancelled: &(dyn Fn() -> bool + Sync),
+) -> Option<Rendered> {
     let (w, h) = (camera.width(), camera.height());
     let start = Instant::now();
     let mut stats = ImageStats {
@@ -181,11 +195,11 @@ pub fn render(
         stats.camera_inside = true;
         stats.misses = stats.rays;
         stats.seconds = start.elapsed().as_secs_f64();
-        return Rendered {
+        return Some(Rendered {
             image,
             depth,
             stats,
-        };
+        });
     }
     let cone = tracer.options().cone;
     let tiles: Vec<Tile> = (0..h.div_ceil(TILE))
@@ -204,6 +218,9 @@ pub fn render(
     let results: Vec<TileResult> = tiles
         .into_par_iter()
         .map(|tile| {
+            if cancelled() {
+                return None;
+            }
             let n = (tile.w * tile.h) as usize;
             let mut colours = vec![background; n];
             let mut tile_depth = vec![f32::INFINITY; n];
@@ -239,9 +256,9 @@ pub fn render(
             if finished.is_multiple_of(tiles_per_row) {
                 progress((finished / tiles_per_row * TILE as u64).min(h as u64));
             }
-            (tile, colours, tile_depth, tile_stats)
+            Some((tile, colours, tile_depth, tile_stats))
         })
-        .collect();
+        .collect::<Option<_>>()?;
     for (tile, colours, tile_depth, tile_stats) in results {
         for (i, (c, d)) in colours.into_iter().zip(tile_depth).enumerate() {
             let (px, py) = (tile.x0 + i as u32 % tile.w, tile.y0 + i as u32 / tile.w);
@@ -252,9 +269,9 @@ pub fn render(
     }
     progress(h as u64);
     stats.seconds = start.elapsed().as_secs_f64();
-    Rendered {
+    Some(Rendered {
         image,
         depth,
         stats,
-    }
+    })
 }
