@@ -6,7 +6,8 @@
 //!   (at most 0.5% of the rays), and depths that agree within the hit band (99% of the
 //!   rays hitting in both within 4 epsilon). Thin features (the net's and hex torus'
 //!   tubes, the bucky ball's struts, the spiky sphere's spikes) are where a skipped
-//!   surface would show.
+//!   surface would show. Over-relaxed steps (`TracerOptions::relax`) likewise against
+//!   plain sphere-tracing steps.
 //! - At beta 0.5 the rendered surface stays close to the exact (beta 0) one: median depth
 //!   error at most 0.1% of the scene's diagonal on the procedural scenes and the bunny.
 //! - The tracer's pruning tolerance (tied to epsilon) keeps every value a lower bound of
@@ -43,39 +44,66 @@ fn render(
     (built.epsilon, built.bounds.diagonal(), r)
 }
 
+/// Procedural scenes with thin features, where a skipped surface would show.
+const THIN: [&str; 6] = [
+    "torus.toml",
+    "net.toml",
+    "hex_torus.toml",
+    "bucky_ball.toml",
+    "spiky_sphere.toml",
+    "bowl.toml",
+];
+
+/// Renders `name` with the tracer defaults and with `off` applied (a shortcut turned
+/// off): same hit mask up to grazing rays, same depths within the hit band. Returns both.
+fn same_surface(
+    name: &str,
+    off: impl Fn(TracerOptions) -> TracerOptions + Send + Sync,
+) -> (Rendered, Rendered) {
+    let s = scene(name, 240, 135);
+    let (eps, _, on) = render(&s, |o| o);
+    let (_, _, plain) = render(&s, off);
+    // Depths in units of epsilon.
+    let d = compare_depths(&on.depth, &plain.depth, 1.0, eps);
+    let only_one = d.only_one_percent();
+    assert!(
+        only_one <= 0.5,
+        "{name}: {only_one:.3}% of the rays hit in only one of the renders ({d:?})"
+    );
+    let p99 = d.p99.unwrap_or(0.0);
+    assert!(
+        p99 <= 4.0,
+        "{name}: 99th percentile depth difference {p99} epsilon"
+    );
+    (on, plain)
+}
+
 #[test]
 fn cone_marching_finds_the_surface_every_ray_finds() {
-    for name in [
-        "torus.toml",
-        "net.toml",
-        "hex_torus.toml",
-        "bucky_ball.toml",
-        "spiky_sphere.toml",
-        "bowl.toml",
-    ] {
-        let s = scene(name, 240, 135);
-        let (eps, _, cone) = render(&s, |o| o);
-        let (_, _, plain) = render(&s, |o| TracerOptions { cone: false, ..o });
+    for name in THIN {
+        let (cone, plain) = same_surface(name, |o| TracerOptions { cone: false, ..o });
         assert!(cone.stats.tile_evals > 0, "{name}: no tile was marched");
         assert_eq!(plain.stats.tile_evals, 0);
-        // Depths in units of epsilon.
-        let d = compare_depths(&cone.depth, &plain.depth, 1.0, eps);
-        let only_one = d.only_one_percent();
-        assert!(
-            only_one <= 0.5,
-            "{name}: {only_one:.3}% of the rays hit in only one of the renders ({d:?})"
-        );
-        let p99 = d.p99.unwrap_or(0.0);
-        assert!(
-            p99 <= 4.0,
-            "{name}: 99th percentile depth difference {p99} epsilon"
-        );
         // The point of it: fewer bound evaluations per ray in all.
         assert!(
             cone.stats.coarse_evals < plain.stats.coarse_evals,
             "{name}: cone {} vs plain {} bound evaluations",
             cone.stats.coarse_evals,
             plain.stats.coarse_evals
+        );
+    }
+}
+
+#[test]
+fn relaxed_steps_find_the_surface_plain_steps_find() {
+    for name in THIN {
+        let (relaxed, plain) = same_surface(name, |o| TracerOptions { relax: false, ..o });
+        let all = |r: &Rendered| r.stats.evals + r.stats.coarse_evals;
+        assert!(
+            all(&relaxed) < all(&plain),
+            "{name}: relaxed {} vs plain {} evaluations",
+            all(&relaxed),
+            all(&plain)
         );
     }
 }

@@ -25,8 +25,11 @@
 //!    visits 25-30% fewer leaves for the same march.
 //! 7. The normal is the normalised gradient at the hit. Steps need only the value, so
 //!    they use value-only evaluations; an evaluation predicted to hit (its predecessor's
-//!    value within two epsilons, or a geometric extrapolation of the last two values
+//!    value within two epsilons, or a linear extrapolation of the last two values
 //!    within one) carries the gradient, so most hits need no second traversal.
+//! 8. Steps are over-relaxed (`Stepper`): up to `2 s / (1 + k)` for a slope `k` of the
+//!    field along the ray, kept only when the next sample's ball closes the gap, else
+//!    the ray returns to the plain step. Same surface, fewer steps at grazing incidence.
 
 use super::object::TraceObject;
 use crate::eval::EvalStats;
@@ -49,6 +52,8 @@ pub struct TracerOptions {
     pub coarse_threshold: f64,
     /// March primary-ray tiles as cones first (`cone`; needs `coarse_beta > 0`).
     pub cone: bool,
+    /// Over-relaxed steps, each certified by the next sample's value (see `Stepper`).
+    pub relax: bool,
     /// Clip rays to the grown scene box (misses outside it cost no evaluation). Off,
     /// rays start at the camera's smooth distance and march to the box's far side, as
     /// in the paper's renderer.
@@ -74,6 +79,7 @@ impl TracerOptions {
             coarse_beta: 4.0,
             coarse_threshold: 4.0,
             cone: true,
+            relax: true,
             clip: true,
             backtrack: Backtrack::Illinois,
         }
@@ -86,6 +92,7 @@ impl TracerOptions {
         TracerOptions {
             coarse_beta: 0.0,
             cone: false,
+            relax: false,
             clip: false,
             backtrack: Backtrack::FixedStep,
             ..TracerOptions::new(epsilon, max_steps)
@@ -120,6 +127,9 @@ pub struct RayStats {
     pub falloffs: u32,
     /// Evaluations spent locating a crossing after overshooting into the negative band.
     pub backtracks: u32,
+    /// Over-relaxed steps whose gap the next sample did not cover (the ray went back to
+    /// the plain step; the sample's evaluation is counted in `evals`/`coarse_evals`).
+    pub rejected_steps: u32,
     /// The ray ran out of steps (counted as a miss).
     pub exhausted: bool,
 }
@@ -304,15 +314,17 @@ impl<'a> Tracer<'a> {
             (0.0, (o - c).length() + 0.5 * (self.max - self.min).length())
         };
         let mut t = t_enter.max(t_start);
+        // The last certified sample: (t, a lower bound of the field there). Everything
+        // up to `t + s` is free of the surface.
         let mut prev: Option<(f64, f64)> = None;
+        let mut stepper = Stepper::new(self.options.relax);
         let coarse = (self.options.coarse_beta > 0.0).then_some(self.options.coarse_beta);
         let tau = self.options.coarse_threshold * eps;
         let mut near = false;
         // Full-accuracy evaluations carry the gradient when they are predicted to hit,
         // so the hit needs no second traversal to be shaded: the next value is guessed
-        // from the last ratio of successive values (sphere tracing converges about
+        // from the slope of the last two values (sphere tracing converges about
         // geometrically), or from the value itself.
-        let mut ratio = 1.0;
         let mut want = Want::Value;
         while t <= t_max {
             if stats.evals + stats.coarse_evals >= self.options.max_steps {
@@ -323,8 +335,14 @@ impl<'a> Tracer<'a> {
             if let (Some(beta), false) = (coarse, near) {
                 let c = self.sample(x, &mut stats, Want::Bound(beta));
                 if c.s > tau {
+                    if let Some(back) = stepper.uncovered(prev, t, c.s) {
+                        stats.rejected_steps += 1;
+                        t = back;
+                        continue;
+                    }
+                    let step = stepper.step(prev, t, c.s, Kind::Bound);
                     prev = Some((t, c.s));
-                    t += c.s;
+                    t += step;
                     continue;
                 }
                 // A coarse value already within the hit band is usually a hit (where
@@ -334,6 +352,13 @@ impl<'a> Tracer<'a> {
                 }
             }
             let f = self.sample(x, &mut stats, want);
+            if let Some(back) = stepper.uncovered(prev, t, f.s) {
+                // An over-relaxed step left a gap: go back to the plain step's end.
+                stats.rejected_steps += 1;
+                t = back;
+                want = Want::Value;
+                continue;
+            }
             near = f.s < 2.0 * tau;
             if f.s.abs() <= eps {
                 let hit = self.hit(o, d, t, &f, &mut stats);
@@ -353,16 +378,16 @@ impl<'a> Tracer<'a> {
                 };
                 return RayResult { hit, stats };
             }
-            if let Some((_, sp)) = prev {
-                ratio = (f.s / sp).min(1.0);
-            }
-            want = if f.s * ratio <= eps || f.s <= 2.0 * eps {
+            let step = stepper.step(prev, t, f.s, Kind::Full);
+            // The value at the next sample, if the field keeps its slope along the ray.
+            let predicted = f.s - stepper.slope * step;
+            want = if predicted <= eps || f.s <= 2.0 * eps {
                 Want::Gradient
             } else {
                 Want::Value
             };
             prev = Some((t, f.s));
-            t += f.s;
+            t += step;
         }
         RayResult { hit: None, stats }
     }
@@ -443,5 +468,153 @@ impl<'a> Tracer<'a> {
             }
         }
         last.map(|(t, f)| self.hit(o, d, t, &f, stats))
+    }
+}
+
+/// Which evaluation a sample came from (slopes are only estimated between samples of
+/// the same kind: a bound and a full value of the same point differ).
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    Bound,
+    Full,
+}
+
+/// Over-relaxed step lengths with their certificate (Keinert et al. 2014, "Enhanced
+/// sphere tracing"). A sample at `t` with a lower bound `s` of the field certifies the
+/// ball of radius `s` around it, so the ray is free of the surface on `[t, t + s]`; a
+/// step longer than `s`, to `t + L`, is kept only if the next sample's ball reaches back
+/// over the gap: `s + s_next >= L`. Otherwise the ray returns to `t + s` (the plain step)
+/// and goes on from there: every accepted step is as safe as a plain one.
+///
+/// The length is chosen from the slope `k` of the field along the ray, estimated from
+/// the last two samples: if the field keeps it, `s_next = s - k L`, and the largest `L`
+/// with overlap is `2 s / (1 + k)`. A factor `RELAX_MARGIN` below that absorbs
+/// curvature; at grazing incidence (`k` small), where plain sphere tracing needs the
+/// most steps (each removes only a share `k` of the value), steps nearly double.
+struct Stepper {
+    on: bool,
+    /// Slope of the field along the ray (decrease per unit of `t`) from the last two
+    /// samples of the same kind, in `[0, 1]`; 1 (no relaxation) until known.
+    slope: f64,
+    last: Option<(f64, f64, Kind)>,
+    /// The last step was longer than its sample's value.
+    relaxed: bool,
+}
+
+/// Share of the overlap limit `2 s / (1 + k)` a relaxed step takes.
+const RELAX_MARGIN: f64 = 0.9;
+
+impl Stepper {
+    fn new(on: bool) -> Stepper {
+        Stepper {
+            on,
+            slope: 1.0,
+            last: None,
+            relaxed: false,
+        }
+    }
+
+    /// If the last step was relaxed and the sample at `t` (lower bound `s`) does not
+    /// close the gap, the plain step's end to go back to (the slope is forgotten).
+    fn uncovered(&mut self, prev: Option<(f64, f64)>, t: f64, s: f64) -> Option<f64> {
+        let (tp, sp) = prev?;
+        if !self.relaxed || sp + s >= t - tp {
+            return None;
+        }
+        self.relaxed = false;
+        self.slope = 1.0;
+        self.last = None;
+        Some(tp + sp)
+    }
+
+    /// The step to take from `t`, where the field is at least `s > 0`.
+    fn step(&mut self, prev: Option<(f64, f64)>, t: f64, s: f64, kind: Kind) -> f64 {
+        if let (Some((tl, sl, kl)), Some(_)) = (self.last, prev)
+            && kl == kind
+            && t > tl
+        {
+            self.slope = ((sl - s) / (t - tl)).clamp(0.0, 1.0);
+        } else {
+            self.slope = 1.0;
+        }
+        self.last = Some((t, s, kind));
+        let factor = if self.on {
+            (RELAX_MARGIN * 2.0 / (1.0 + self.slope)).max(1.0)
+        } else {
+            1.0
+        };
+        self.relaxed = factor > 1.0;
+        factor * s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Marches a 1-D field (`lower(t)` a lower bound of a 1-Lipschitz `f`) the way the
+    /// tracer does, returning the hit `t` and the number of samples.
+    fn march(lower: impl Fn(f64) -> f64, eps: f64, relax: bool) -> (f64, u32) {
+        let mut stepper = Stepper::new(relax);
+        let (mut t, mut prev, mut n) = (0.0, None, 0);
+        loop {
+            let s = lower(t);
+            n += 1;
+            assert!(n < 10_000, "no convergence");
+            if let Some(back) = stepper.uncovered(prev, t, s) {
+                t = back;
+                continue;
+            }
+            if s <= eps {
+                return (t, n);
+            }
+            let step = stepper.step(prev, t, s, Kind::Full);
+            prev = Some((t, s));
+            t += step;
+        }
+    }
+
+    #[test]
+    fn relaxed_steps_never_pass_the_first_zero() {
+        // Fields with zeros at random places, reached at random slopes, some of them
+        // isolated points (a thin feature the ray only touches); the samples are a
+        // random share (60-100%) of the field, as Barnes-Hut lower bounds are.
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut plain_n, mut relaxed_n) = (0, 0);
+        for _ in 0..2000 {
+            let zeros: Vec<(f64, f64)> = (0..4).map(|_| (1.0 + 99.0 * rnd(), 0.02 + 0.98 * rnd())).collect();
+            let first = zeros.iter().map(|z| z.0).fold(f64::INFINITY, f64::min);
+            let f = |t: f64| {
+                zeros
+                    .iter()
+                    .map(|&(z, k)| k * (z - t).abs())
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let share = 0.6 + 0.4 * rnd();
+            let wobble = rnd();
+            let lower = |t: f64| f(t) * (share + (1.0 - share) * (t * wobble).sin().abs());
+            let eps = 1e-3;
+            for relax in [false, true] {
+                let (t, n) = march(lower, eps, relax);
+                assert!(t <= first, "passed the first zero {first} at {t} (relax {relax})");
+                // The sample there was at most eps, and at least 60% of the field.
+                assert!(f(t) <= eps / 0.6, "stopped at {t} where the field is {}", f(t));
+                if relax {
+                    relaxed_n += n;
+                } else {
+                    plain_n += n;
+                }
+            }
+        }
+        assert!(
+            relaxed_n < plain_n * 9 / 10,
+            "relaxed {relaxed_n} vs plain {plain_n} samples"
+        );
     }
 }

@@ -1,0 +1,113 @@
+//! Ray probe: replays the tracer's march on a sample of hit rays and prints, per step,
+//! the bound value (coarse beta), the full value and the exact (beta 0) value, so the
+//! final approach can be studied. Run:
+//! `cargo run --release --example ray_probe -- scenes/deer_alpha1.toml [W H]`
+use glam::DVec3;
+use smoothtrace::eval::evaluate_value;
+use smoothtrace::render::build::build_scene;
+use smoothtrace::render::tracer::{RayStats, Tracer, TracerOptions};
+use smoothtrace::scene::Scene;
+use std::path::Path;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let mut scene = Scene::load(Path::new(&args[1])).expect("scene");
+    let w: u32 = args.get(2).map(|s| s.parse().unwrap()).unwrap_or(160);
+    let h: u32 = args.get(3).map(|s| s.parse().unwrap()).unwrap_or(90);
+    scene.image.width = w;
+    scene.image.height = h;
+    let built = build_scene(&scene).expect("build");
+    let opts = TracerOptions::new(built.epsilon, scene.render.max_steps);
+    let tracer = Tracer::new(&built.objects, opts);
+    let eps = built.epsilon;
+    let cam = &built.camera;
+    let obj = &built.objects[0];
+    let sets = obj.set_refs();
+    if let (Some(px), Some(py)) = (args.get(4), args.get(5)) {
+        let (px, py): (u32, u32) = (px.parse().unwrap(), py.parse().unwrap());
+        let (o, d) = cam.ray(px, py);
+        let mut p = obj.params;
+        p.beta = 0.0;
+        let exact = |x: DVec3| evaluate_value(&sets, x, &p).s;
+        for relax in [false, true] {
+            let tr = Tracer::new(&built.objects, TracerOptions { relax, ..opts });
+            let mut st = RayStats::default();
+            let (s0, _) = tr.field(o, &mut st);
+            let r = tr.trace(o, d, s0);
+            println!("relax {relax}: hit {:?} evals {} bound {}", r.hit.map(|h| h.t), r.stats.evals, r.stats.coarse_evals);
+            if let Some(h) = r.hit {
+                let mut line = String::new();
+                for k in -20..=20 {
+                    let t = h.t + k as f64 * 0.5 * eps;
+                    let mut st = RayStats::default();
+                    line += &format!(" {:.2}/{:.2}", tr.field(o + t * d, &mut st).0 / eps, exact(o + t * d) / eps);
+                }
+                println!("  s_BH/s_exact around the hit, steps of eps/2 (in eps): {line}");
+            }
+        }
+        return;
+    }
+    let mut printed = 0;
+    let mut hist_start = Vec::new();
+    for py in (0..h).step_by(3) {
+        for px in (0..w).step_by(3) {
+            let (o, d) = cam.ray(px, py);
+            let r = tracer.trace(o, d, 0.0);
+            let Some(hit) = r.hit else { continue };
+            // Replay: plain march by the full value from well before the hit.
+            let mut p = obj.params;
+            p.beta = 0.0;
+            let exact = |x: DVec3| evaluate_value(&sets, x, &p).s;
+            let slope = {
+                let a = exact(o + (hit.t - 2.0 * eps) * d);
+                let b = exact(o + (hit.t - 12.0 * eps) * d);
+                (b - a) / (10.0 * eps)
+            };
+            let mut st = RayStats::default();
+            // where does the bound drop below 4 eps
+            let mut t = 0.0f64.max(hit.t - 200.0 * (1.0 / obj.params.alpha));
+            let mut line = String::new();
+            let mut first_full = None;
+            for _ in 0..60 {
+                let x = o + t * d;
+                let c = tracer.bound(x, opts.coarse_beta, &mut st);
+                let (f, _) = tracer.field(x, &mut st);
+                if c <= 4.0 * eps && first_full.is_none() {
+                    first_full = Some(f / eps);
+                }
+                if printed < 12 && c <= 50.0 * eps {
+                    line += &format!(" [{:.1} {:.1} {:.1}]", c / eps, f / eps, exact(x) / eps);
+                }
+                if f.abs() <= eps {
+                    break;
+                }
+                t += if c > 4.0 * eps { c } else { f };
+            }
+            if printed < 12 {
+                println!(
+                    "px {px} {py}: evals {} bound {} slope {slope:.3} |grad.d| {:.3}\n  {line}",
+                    r.stats.evals,
+                    r.stats.coarse_evals,
+                    hit.normal.dot(d).abs()
+                );
+                printed += 1;
+            }
+            hist_start.push((first_full.unwrap_or(f64::NAN), r.stats.evals, slope));
+        }
+    }
+    let n = hist_start.len() as f64;
+    let mut s: Vec<f64> = hist_start.iter().map(|x| x.0).collect();
+    s.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    let mut sl: Vec<f64> = hist_start.iter().map(|x| x.2).collect();
+    sl.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    println!(
+        "rays {n}: full value (in eps) where the bound first <= 4 eps: p10 {:.1} p50 {:.1} p90 {:.1}; evals mean {:.2}; slope p10 {:.2} p50 {:.2} p90 {:.2}",
+        s[(0.1 * n) as usize],
+        s[(0.5 * n) as usize],
+        s[(0.9 * n) as usize],
+        hist_start.iter().map(|x| x.1 as f64).sum::<f64>() / n,
+        sl[(0.1 * n) as usize],
+        sl[(0.5 * n) as usize],
+        sl[(0.9 * n) as usize],
+    );
+}
