@@ -79,7 +79,13 @@ pub fn build(bounds: &[Aabb], centroids: &[Vec3], options: BuildOptions) -> Bvh 
             },
         );
     let nodes = build_range(&input, &mut order, 0, rb);
-    Bvh { nodes, order }
+    let (wide_root, wide) = super::wide::collapse(&nodes);
+    Bvh {
+        nodes,
+        order,
+        wide_root,
+        wide,
+    }
 }
 
 /// Builds the subtree over `items` (which start at `offset` in the final order) into a

@@ -8,9 +8,11 @@
 
 mod build;
 mod validate;
+pub mod wide;
 
 pub use build::{BuildOptions, build};
 pub use validate::validate;
+pub use wide::{Node4, Root};
 
 use glam::{DVec3, Vec3};
 
@@ -56,6 +58,10 @@ impl Node {
 pub struct Bvh {
     pub nodes: Vec<Node>,
     pub order: Vec<u32>,
+    /// The same tree 4 wide, for the smooth-distance traversal (`wide`): its root as a
+    /// child slot (`None` when empty) and its nodes.
+    pub wide_root: Option<Root>,
+    pub wide: Vec<Node4>,
 }
 
 impl Bvh {
@@ -84,6 +90,8 @@ impl Bvh {
     }
 
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.len() * std::mem::size_of::<Node>() + self.order.len() * 4
+        self.nodes.len() * std::mem::size_of::<Node>()
+            + self.wide.len() * std::mem::size_of::<Node4>()
+            + self.order.len() * 4
     }
 }

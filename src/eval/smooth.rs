@@ -16,8 +16,17 @@
 //!   primitive below is at least `r` away with weight at most `w_ff`, so the far term
 //!   dominates the terms it replaces and the approximate `s` never exceeds the exact one.
 //! - otherwise descend; leaves add their primitives' exact terms.
+//!
+//! The walk runs on the BVH's 4-wide form (`bvh::wide`): opening a wide node tests the
+//! four grandchildren of a binary node at once and makes the decisions above for the
+//! two children between (far field at the distance of the nearer of their own
+//! children's boxes, which bounds every primitive below from below, as the box does)
+//! and then for the grandchildren. Far-field terms are added when their parent is
+//! opened; the rest is pushed farthest first, so leaves are still met near to far.
 
 use super::accumulate::{Accumulation, Accumulator};
+use crate::bvh::Node4;
+use crate::bvh::wide::EMPTY;
 use crate::primitives::{AnySet, Primitive, PrimitiveSet, WeightScale};
 use glam::DVec3;
 
@@ -126,10 +135,12 @@ fn evaluate_impl<const GRAD: bool>(sets: &[&AnySet], x: DVec3, p: &EvalParams) -
     } else {
         f64::INFINITY
     };
-    for set in sets {
-        let sc = scale(set);
-        crate::with_set!(set, s => traverse::<_, GRAD>(s, x, p, &sc, prune_margin, &mut acc, &mut stats));
-    }
+    STACK.with_borrow_mut(|stack| {
+        for set in sets {
+            let sc = scale(set);
+            crate::with_set!(set, s => traverse::<_, GRAD>(s, x, p, &sc, prune_margin, &mut acc, &mut stats, stack));
+        }
+    });
     if stats.pruned > 0 {
         // The pruned subtrees hold less than the tolerance of the final sum (see the
         // module docs): add that bound back so s never exceeds the exact value.
@@ -145,10 +156,53 @@ fn evaluate_impl<const GRAD: bool>(sets: &[&AnySet], x: DVec3, p: &EvalParams) -
     }
 }
 
-/// Depth of the traversal stack: the BVH depth is far below this for any input that
-/// fits in memory (binned SAH with a median fallback).
-const STACK: usize = 128;
+/// A traversal stack entry: wide node (or first primitive of a leaf), the leaf's
+/// primitive count (0 for a wide node), squared distance to its box.
+type Entry = (u32, u32, f64);
 
+thread_local! {
+    /// Each thread's traversal stack, kept between evaluations (it holds at most three
+    /// entries per level of the wide tree plus one).
+    static STACK: std::cell::RefCell<Vec<Entry>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Squared distances from `x` to the four child boxes of a wide node (0 inside; `+inf`
+/// for an unused slot, whose box is inverted), in f64, four lanes at a time.
+#[inline]
+fn child_distances2(node: &Node4, x: DVec3) -> [f64; 4] {
+    let mut d2 = [0.0f64; 4];
+    for (a, xa) in x.to_array().into_iter().enumerate() {
+        for (k, d2k) in d2.iter_mut().enumerate() {
+            let below = node.min[a][k] as f64 - xa;
+            let above = xa - node.max[a][k] as f64;
+            let d = if below > above { below } else { above };
+            let d = if d > 0.0 { d } else { 0.0 };
+            *d2k += d * d;
+        }
+    }
+    d2
+}
+
+/// The far-field term of a subtree with box `min..max` at squared distance `r2 > 0`.
+#[inline]
+fn far_term<const GRAD: bool>(
+    acc: &mut Accumulator,
+    x: DVec3,
+    r2: f64,
+    weight: f64,
+    min: DVec3,
+    max: DVec3,
+) {
+    let r = r2.sqrt();
+    if GRAD {
+        let c = x.clamp(min, max);
+        acc.add(r, weight, (x - c) / r, DVec3::ZERO);
+    } else {
+        acc.add_value(r, weight);
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 fn traverse<P: Primitive, const GRAD: bool>(
     set: &PrimitiveSet<P>,
     x: DVec3,
@@ -157,31 +211,43 @@ fn traverse<P: Primitive, const GRAD: bool>(
     prune_margin: f64,
     acc: &mut Accumulator,
     stats: &mut EvalStats,
+    stack: &mut Vec<Entry>,
 ) {
-    let nodes = &set.bvh.nodes;
-    if nodes.is_empty() {
+    let bvh = &set.bvh;
+    let Some(root) = bvh.wide_root else {
         return;
-    }
+    };
+    let wide = &bvh.wide;
     let w_ff = scale.max_weight();
     let beta2 = p.beta * p.beta;
     let inv_alpha = 1.0 / p.alpha;
-    // The stack holds squared box distances; square roots are taken only for far terms.
-    let mut stack: [(u32, f64); STACK] = [(0, 0.0); STACK];
-    let mut top = 1;
-    stack[0] = (0, nodes[0].distance_squared(x));
-    while top > 0 {
-        top -= 1;
-        let (i, r2) = stack[top];
-        let node = &nodes[i as usize];
+    // The root is a child slot like any other: far field, or pushed.
+    let (rmin, rmax) = (
+        DVec3::from(root.min.map(f64::from)),
+        DVec3::from(root.max.map(f64::from)),
+    );
+    let r2 = (x - x.clamp(rmin, rmax)).length_squared();
+    if root.count == 0 && p.beta > 0.0 && (root.diam2 as f64) < beta2 * r2 {
+        far_term::<GRAD>(acc, x, r2, root.size as f64 * w_ff, rmin, rmax);
+        stats.far += 1;
+        return;
+    }
+    // Entries: (wide node or first primitive, leaf primitive count or 0, squared
+    // distance). Far-field children are summed when their parent is opened; the others
+    // are pushed farthest first, so they are popped near to far.
+    stack.clear();
+    stack.push((root.child, root.count, r2));
+    while let Some((i, count, r2)) = stack.pop() {
         stats.nodes += 1;
         let reach = acc.m + (prune_margin - acc.ln_sum_lower_bound() * inv_alpha);
-        if r2 > reach * reach {
+        let reach2 = reach * reach;
+        if r2 > reach2 {
             stats.pruned += 1;
             continue;
         }
-        if node.is_leaf() {
-            let first = node.index as usize;
-            for prim in &set.prims[first..first + node.count as usize] {
+        if count > 0 {
+            let first = i as usize;
+            for prim in &set.prims[first..first + count as usize] {
                 if GRAD {
                     let t = prim.term(x, scale);
                     acc.add(t.d, t.w, t.dir, t.grad_w);
@@ -190,33 +256,74 @@ fn traverse<P: Primitive, const GRAD: bool>(
                     acc.add_value(d, w);
                 }
             }
-            stats.exact += node.count;
+            stats.exact += count;
             continue;
         }
-        let diam = node.diam as f64;
-        if p.beta > 0.0 && diam * diam < beta2 * r2 {
-            let r = r2.sqrt();
-            if GRAD {
-                let (_, c) = node.distance(x);
-                acc.add(r, node.size as f64 * w_ff, (x - c) / r, DVec3::ZERO);
-            } else {
-                acc.add_value(r, node.size as f64 * w_ff);
-            }
-            stats.far += 1;
-            continue;
-        }
-        let (l, rr) = (i + 1, node.index);
-        let dl = nodes[l as usize].distance_squared(x);
-        let dr = nodes[rr as usize].distance_squared(x);
-        // Push the farther child first so the nearer one is popped next.
-        let (first, second) = if dl <= dr {
-            ((rr, dr), (l, dl))
-        } else {
-            ((l, dl), (rr, dr))
+        let node = &wide[i as usize];
+        let d2 = child_distances2(node, x);
+        let slot_box = |k: usize| {
+            (
+                DVec3::new(
+                    node.min[0][k] as f64,
+                    node.min[1][k] as f64,
+                    node.min[2][k] as f64,
+                ),
+                DVec3::new(
+                    node.max[0][k] as f64,
+                    node.max[1][k] as f64,
+                    node.max[2][k] as f64,
+                ),
+            )
         };
-        debug_assert!(top + 2 <= STACK);
-        stack[top] = first;
-        stack[top + 1] = second;
-        top += 2;
+        // Children to open, as (squared distance, slot), sorted farthest first.
+        let mut open = [(0.0f64, 0usize); 4];
+        let mut n = 0;
+        for j in 0..2 {
+            // The middle: pruned or far field as a whole, at the distance of its nearer
+            // child box (a lower bound of every distance below it).
+            let near = if d2[2 * j] <= d2[2 * j + 1] {
+                2 * j
+            } else {
+                2 * j + 1
+            };
+            let r2m = d2[near];
+            if r2m > reach2 {
+                stats.pruned += 1;
+                continue;
+            }
+            if p.beta > 0.0 && (node.mid_diam2[j] as f64) < beta2 * r2m {
+                let (min, max) = slot_box(near);
+                far_term::<GRAD>(acc, x, r2m, node.mid_size[j] as f64 * w_ff, min, max);
+                stats.far += 1;
+                continue;
+            }
+            for k in [2 * j, 2 * j + 1] {
+                let c = node.count[k];
+                if c == EMPTY {
+                    continue;
+                }
+                if d2[k] > reach2 {
+                    stats.pruned += 1;
+                    continue;
+                }
+                if c == 0 && p.beta > 0.0 && (node.diam2[k] as f64) < beta2 * d2[k] {
+                    let (min, max) = slot_box(k);
+                    far_term::<GRAD>(acc, x, d2[k], node.size[k] as f64 * w_ff, min, max);
+                    stats.far += 1;
+                    continue;
+                }
+                // Insertion into the farthest-first order.
+                let mut h = n;
+                while h > 0 && open[h - 1].0 < d2[k] {
+                    open[h] = open[h - 1];
+                    h -= 1;
+                }
+                open[h] = (d2[k], k);
+                n += 1;
+            }
+        }
+        for &(r2, k) in &open[..n] {
+            stack.push((node.child[k], node.count[k], r2));
+        }
     }
 }
