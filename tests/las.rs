@@ -601,7 +601,7 @@ fn scene_keys_resolve_and_bad_values_are_named() {
             &["s.toml:13:", "object[0].returns", "\"first\""],
         ),
         (
-            "color_by = \"height\"",
+            "color_by = \"altitude\"",
             &["s.toml:13:", "object[0].color_by", "\"rgb\""],
         ),
         (
