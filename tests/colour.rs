@@ -56,7 +56,9 @@ fn ascii_ply(props: &str, rows: &[&str]) -> Vec<u8> {
 fn ply_and_obj_colours_read_as_written() {
     let dir = tempfile::tempdir().unwrap();
     let uchar = "property uchar red\nproperty uchar green\nproperty uchar blue\n";
-    let cases: Vec<(&str, Vec<u8>, [[f64; 3]; 2])> = vec![
+    // (file name, bytes, the two vertices' colours as written, as fractions)
+    type Case = (&'static str, Vec<u8>, [[f64; 3]; 2]);
+    let cases: Vec<Case> = vec![
         (
             "uchar.ply",
             ascii_ply(uchar, &["0 0 0 255 0 128", "1 0 0 10 200 3"]),
@@ -257,14 +259,13 @@ fn scene(mesh: &str, object: &str) -> String {
 }
 
 fn scene_error(text: &str) -> String {
-    let e = match Scene::from_str(text, Path::new("c.toml")) {
+    match Scene::from_str(text, Path::new("c.toml")) {
         Err(e) => e.to_string(),
         Ok(s) => match build_scene(&s) {
             Err(e) => e.to_string(),
             Ok(_) => panic!("accepted: {text}"),
         },
-    };
-    e
+    }
 }
 
 #[test]

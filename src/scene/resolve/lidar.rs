@@ -13,6 +13,9 @@ use crate::las::{ColorBy, LasFilters, LasOptions, NOISE_CLASSES, Returns, Thin};
 use glam::DVec3;
 use toml::Spanned;
 
+/// A lidar attribute and its colormap, or a geometric colouring (at most one is set).
+type ColourKeys = (Option<ColorBy>, Option<Colormap>, Option<GeometryColouring>);
+
 impl Resolver<'_> {
     pub(super) fn lidar(
         &mut self,
@@ -77,11 +80,7 @@ impl Resolver<'_> {
 
     /// `color_by` and `colormap`: a lidar attribute (with its colormap, checked against
     /// the file by the validator) or a geometric colouring for any object.
-    fn colour_keys(
-        &mut self,
-        name: &str,
-        raw: &RawObject,
-    ) -> Result<(Option<ColorBy>, Option<Colormap>, Option<GeometryColouring>), SceneError> {
+    fn colour_keys(&mut self, name: &str, raw: &RawObject) -> Result<ColourKeys, SceneError> {
         let colormap = match &raw.colormap {
             None => None,
             Some(v) => Some(self.named(name, "colormap", v, Colormap::from_name, || {
