@@ -6,6 +6,8 @@
 //! (f32 linear colours; the softmax weights of far points are below exp(-60)).
 //! The golden image of a colour-by-vertex scene is in tests/golden.rs.
 
+mod common;
+
 use glam::DVec3;
 use smoothtrace::colour::{Colormap, SetColours, to_srgb8};
 use smoothtrace::eval::EvalParams;
@@ -399,4 +401,71 @@ fn height_and_normal_colourings() {
         object: 0,
     };
     assert_eq!(shade_hit(&built.objects, &hit, shaded), shaded);
+}
+
+/// The command line: bad colour input exits with status 2 and a message naming the
+/// field or property; a good one renders.
+#[test]
+fn render_exits_2_on_bad_colour_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "plain.obj", b"v 0 0 0\nv 1 0 0\n");
+    write(d, "rgb.obj", b"v 0 0 0 1 0 0\nv 1 0 0 0 0 1\n");
+    write(
+        d,
+        "short.ply",
+        &ascii_ply(
+            "property short red\nproperty short green\nproperty short blue\n",
+            &["0 0 0 1 2 3"],
+        ),
+    );
+    let bin = || std::process::Command::new(env!("CARGO_BIN_EXE_smoothtrace"));
+    for (mesh, extra, code, needles) in [
+        (
+            "plain.obj",
+            "color_by = \"vertex\"",
+            2,
+            &["object[0].color_by", "no vertex colours"][..],
+        ),
+        (
+            "plain.obj",
+            "color_by = \"hue\"",
+            2,
+            &["s.toml:11:", "object[0].color_by"],
+        ),
+        (
+            "plain.obj",
+            "color_by = \"height\"\ncolormap = \"rainbow\"",
+            2,
+            &["s.toml:12:", "object[0].colormap"],
+        ),
+        (
+            "short.ply",
+            "color_by = \"vertex\"",
+            2,
+            &["short.ply", "'red'", "'short'"],
+        ),
+        ("rgb.obj", "color_by = \"vertex\"", 0, &[]),
+    ] {
+        let text = format!(
+            "[camera]\norigin = [0.5, 0, 3]\ntarget = [0.5, 0, 0]\n[image]\nwidth = 16\n\
+             height = 12\n[[object]]\nmesh = \"{mesh}\"\nprimitives = \"points\"\n\
+             alpha = 20.0\n{extra}\n"
+        );
+        write(d, "s.toml", text.as_bytes());
+        let out = common::run_cli(bin(), &["render", "s.toml", "-o", "o.png"], d, None);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{extra}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{extra}: message lacks `{n}`: {err}");
+        }
+    }
+    // The good render has the two colours: red on the left point, blue on the right.
+    let img = image::open(d.join("o.png")).unwrap().to_rgb8();
+    let (mut red, mut blue) = (0, 0);
+    for p in img.pixels() {
+        red += (p[0] > 2 * p[2].max(8)) as usize;
+        blue += (p[2] > 2 * p[0].max(8)) as usize;
+    }
+    assert!(red > 0 && blue > 0, "red pixels {red}, blue pixels {blue}");
 }
