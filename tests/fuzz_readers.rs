@@ -741,3 +741,45 @@ proptest! {
         fuzz_lidar("simple.laz", "laz", &muts);
     }
 }
+
+// ---------------------------------------------------------------------------------
+// Vertex colours (`color_by = "vertex"`): mutated copies of the coloured torus PLY and
+// of a coloured OBJ, read with `Mesh::load_with_vertex_colours` from a temporary file:
+// no panic, and either an error naming the file or one colour per vertex, each channel
+// in linear 0..=1.
+
+fn fuzz_coloured(seed: &[u8], ext: &str, muts: &[Mutation]) {
+    let mut bytes = seed.to_vec();
+    for m in muts {
+        apply(&mut bytes, m);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(format!("fuzzed.{ext}"));
+    std::fs::write(&path, &bytes).unwrap();
+    let r = Mesh::load_with_vertex_colours(&path);
+    match r {
+        Ok((mesh, colours)) => {
+            if let Some(c) = colours {
+                assert_eq!(c.len(), mesh.vertices.len());
+                assert!(c.iter().flatten().all(|v| (0.0..=1.0).contains(v)));
+            }
+            check_outcome(&Ok(mesh), &path);
+        }
+        Err(e) => check_outcome(&Err(e), &path),
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: (cases() / 10).max(20), ..config() })]
+
+    #[test]
+    fn mutated_coloured_files_never_panic(obj in any::<bool>(), muts in proptest::collection::vec(mutation(), 1..4)) {
+        if obj {
+            let seed = b"v 0 0 0 1 0 0\nv 1 0 0 0 0.5 1\nv 0 1 0 0.2 0.2 0.2\nf 1 2 3\n";
+            fuzz_coloured(seed, "obj", &muts);
+        } else {
+            let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/colour_torus.ply");
+            fuzz_coloured(&std::fs::read(path).unwrap(), "ply", &muts);
+        }
+    }
+}
