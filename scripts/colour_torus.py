@@ -22,8 +22,7 @@ for i in range(NU):
     for j in range(NV):
         v = 2 * math.pi * j / NV
         r = MAJOR + MINOR * math.cos(v)
-        colour = band
-        verts.append((r * math.cos(u), MINOR * math.sin(v), r * math.sin(u), colour))
+        verts.append((r * math.cos(u), MINOR * math.sin(v), r * math.sin(u), band))
 for i in range(NU):
     for j in range(NV):
         a = i * NV + j
