@@ -1,9 +1,9 @@
 //! The lidar keys of an `[[object]]`: filters (`classes`, `exclude_classes`, `returns`,
 //! `crop`, `thin`), `origin`, and colour (`color_by`, `colormap`), resolved into
 //! [`LasOptions`]; `color_by` also takes the colourings of any object (`vertex`,
-//! `height`, `normal`: [`GeometryColouring`]). Values that make no sense on their own (a class above 255, a voxel
-//! of size 0, an unknown name) are rejected here with their location; whether the
-//! object is a lidar file at all is checked by the validator.
+//! `height`, `normal`: [`GeometryColouring`]). Values that make no sense on their own (a
+//! class above 255, a voxel of size 0, an unknown name) are rejected here with their
+//! location; whether the object is a lidar file at all is checked by the validator.
 
 use super::super::error::SceneError;
 use super::super::raw::{RawCrop, RawObject, RawThin};
