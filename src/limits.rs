@@ -36,6 +36,11 @@ pub const MAX_ALPHA: f64 = 1e30;
 /// Largest input file read (meshes, scene files, query points): 4 GiB.
 pub const MAX_INPUT_BYTES: u64 = 4 << 30;
 
+/// Most points a LAZ chunk may announce: LASzip and PDAL write 50 000, COPC nodes hold
+/// about 100 000; the parallel decoder allocates a whole chunk's records at once, so a
+/// corrupt count must not reach it (`las::layout_check`).
+pub const MAX_LAZ_CHUNK_POINTS: u64 = 1 << 22;
+
 /// `None` when `v` is an accepted vertex coordinate, else why not.
 pub fn coordinate_problem(v: f64) -> Option<String> {
     limit_problem(v, MAX_COORD)

@@ -130,6 +130,13 @@ fn golden_bucky_ball() {
     check("bucky_ball.toml");
 }
 
+/// Colour from the data (issue 11 item 6): per-vertex PLY colours through the smooth
+/// colour field, shaded by the MatCap.
+#[test]
+fn golden_colour_vertex() {
+    check("colour_vertex.toml");
+}
+
 #[test]
 fn renders_do_not_depend_on_the_thread_count() {
     for scene in ["showcase.toml", "spiky_sphere.toml"] {

@@ -373,6 +373,45 @@ fn corrupt_and_truncated_files_are_clear_errors() {
     }
 }
 
+/// Regression for the abort `mutated_laz_never_panics` found: a LAZ chunk table whose
+/// chunk count (or offset) is corrupt is refused, naming the file, before the decoder
+/// reserves memory for it.
+#[test]
+fn laz_chunk_table_counts_beyond_the_file_are_errors_not_aborts() {
+    let Some(seed) = data_file("las/simple.laz") else {
+        return;
+    };
+    let bytes = std::fs::read(&seed).unwrap();
+    let data_start = u32::from_le_bytes(bytes[96..100].try_into().unwrap()) as usize;
+    let table = i64::from_le_bytes(bytes[data_start..data_start + 8].try_into().unwrap());
+    assert!(
+        table as usize > data_start && (table as usize) < bytes.len(),
+        "{table}"
+    );
+    let table = table as usize;
+    let dir = tempfile::tempdir().unwrap();
+    let mut cases: Vec<(&str, Vec<u8>, &str)> = Vec::new();
+    for count in [u32::MAX, 1 << 20] {
+        let mut b = bytes.clone();
+        b[table + 4..table + 8].copy_from_slice(&count.to_le_bytes());
+        cases.push(("chunks", b, "chunks, but the"));
+    }
+    let mut b = bytes.clone();
+    b[data_start..data_start + 8].copy_from_slice(&(bytes.len() as i64 * 4).to_le_bytes());
+    cases.push(("offset", b, "beyond the end"));
+    for (i, (what, b, want)) in cases.into_iter().enumerate() {
+        let name = format!("bad_{what}_{i}.laz");
+        let path = dir.path().join(&name);
+        std::fs::write(&path, b).unwrap();
+        let m = expect_file_error(&path, &name);
+        assert!(m.contains(want), "{m}");
+    }
+    // The unchanged file still reads.
+    let path = dir.path().join("same.laz");
+    std::fs::write(&path, &bytes).unwrap();
+    assert!(las::read(&path, &keep_all()).is_ok());
+}
+
 #[test]
 fn lidar_gives_points_only() {
     let Some(laz) = data_file("las/autzen_trim.laz") else {
@@ -562,7 +601,7 @@ fn scene_keys_resolve_and_bad_values_are_named() {
             &["s.toml:13:", "object[0].returns", "\"first\""],
         ),
         (
-            "color_by = \"height\"",
+            "color_by = \"altitude\"",
             &["s.toml:13:", "object[0].color_by", "\"rgb\""],
         ),
         (

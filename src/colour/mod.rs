@@ -7,13 +7,16 @@
 //!
 //! - [`colormap`]: `viridis`, `magma`, `turbo`, ... (via the `colorous` crate), by name.
 //! - [`palette`]: the ASPRS standard class colours (LAS 1.4 R15, table 17 classes).
+//! - [`by_geometry`]: `color_by = "vertex" | "height" | "normal"` for any object.
 //! - [`set_colours`]: a primitive set's colours in BVH leaf order plus each node's mean:
 //!   what the colour traversal (`crate::eval::colour`) reads.
 
+pub mod by_geometry;
 pub mod colormap;
 pub mod palette;
 pub mod set_colours;
 
+pub use by_geometry::{GeometryColorBy, GeometryColouring};
 pub use colormap::Colormap;
 pub use set_colours::{ObjectColours, SetColours};
 
@@ -22,14 +25,16 @@ pub type Linear = [f32; 3];
 
 /// sRGB code (0..=255) to linear light (IEC 61966-2-1).
 pub fn srgb8_to_linear(c: [u8; 3]) -> Linear {
-    c.map(|v| {
-        let s = v as f32 / 255.0;
-        if s <= 0.04045 {
-            s / 12.92
-        } else {
-            ((s + 0.055) / 1.055).powf(2.4)
-        }
-    })
+    c.map(|v| srgb_to_linear(v as f32 / 255.0))
+}
+
+/// One sRGB-encoded channel in 0..1 to linear light (IEC 61966-2-1).
+pub fn srgb_to_linear(s: f32) -> f32 {
+    if s <= 0.04045 {
+        s / 12.92
+    } else {
+        ((s + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 /// Linear light to sRGB code, clamped to 0..=255 (NaN gives 0).

@@ -21,6 +21,8 @@ pub struct SetColours {
 #[derive(Clone, Debug, Default)]
 pub struct ObjectColours {
     pub sets: Vec<SetColours>,
+    /// Colour by the surface normal at the hit instead (`sets` is then empty).
+    pub from_normal: bool,
 }
 
 impl SetColours {

@@ -14,6 +14,7 @@
 
 pub mod attributes;
 pub mod filter;
+pub mod layout_check;
 
 pub use attributes::ColorBy;
 pub use filter::{FilterCount, LasFilters, NOISE_CLASSES, Returns, Thin};
@@ -83,6 +84,13 @@ fn format_error(path: &Path, message: String) -> MeshError {
 /// stream, an attribute the point format does not have, no point left after filtering.
 pub fn read(path: &Path, options: &LasOptions) -> Result<LasCloud, MeshError> {
     let file = crate::limits::open_input_file(path).map_err(|source| MeshError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    // Before the crates size any buffer from the header: see `layout_check`.
+    layout_check::check_layout(&file).map_err(|m| format_error(path, m))?;
+    let mut file = file;
+    std::io::Seek::rewind(&mut file).map_err(|source| MeshError::Io {
         path: path.to_path_buf(),
         source,
     })?;

@@ -11,6 +11,7 @@ mod obj;
 mod ply;
 mod ply_check;
 mod stl;
+mod vertex_colours;
 
 pub use error::MeshError;
 

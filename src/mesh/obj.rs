@@ -2,7 +2,8 @@
 //!
 //! Supported statements:
 //! - `v x y z [w ...]`: a vertex; anything after `z` (a rational weight or vertex
-//!   colour components) is ignored.
+//!   colour components) is ignored, except `v x y z r g b` colours when they are asked
+//!   for ([`parse_obj_coloured`], rules in `super::vertex_colours`).
 //! - `f i j k ...`: a polygon of any size >= 3, fan-triangulated into
 //!   [`Mesh::triangles`] as `(i, j, k), (i, k, l), ...`.
 //! - `l i j k ...`: a polyline of >= 2 vertices, split into consecutive
@@ -28,14 +29,26 @@
 //!
 //! The file is read whole and parsed as bytes, without a per-line allocation.
 
-use super::{Mesh, MeshError};
+use super::{Mesh, MeshError, vertex_colours};
+use crate::colour::Linear;
 use glam::Vec3;
 use std::path::Path;
 
 /// Parses OBJ text held in `bytes`; `path` is only used in errors.
 pub(super) fn parse_obj(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
+    Ok(parse_obj_coloured(bytes, path, false)?.0)
+}
+
+/// [`parse_obj`], plus the vertices' `r g b` colours (linear) when `colours` is set and
+/// the file has them.
+pub(super) fn parse_obj_coloured(
+    bytes: &[u8],
+    path: &Path,
+    colours: bool,
+) -> Result<(Mesh, Option<Vec<Linear>>), MeshError> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let mut mesh = Mesh::default();
+    let mut rgb = ObjColours::default();
     for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
         let line = i + 1;
         let content = match raw.iter().position(|&b| b == b'#') {
@@ -63,6 +76,9 @@ pub(super) fn parse_obj(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
                     *c = parse_coordinate(token).map_err(err)?;
                 }
                 mesh.vertices.push(Vec3::from_array(xyz));
+                if colours {
+                    rgb.add(tokens, line).map_err(err)?;
+                }
             }
             b"f" => {
                 let count = mesh.vertices.len();
@@ -116,7 +132,75 @@ pub(super) fn parse_obj(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
             _ => {}
         }
     }
-    Ok(mesh)
+    Ok((mesh, rgb.colours))
+}
+
+/// The `r g b` of `v` lines, checked to be on every vertex or none.
+#[derive(Default)]
+struct ObjColours {
+    /// One per vertex so far; `None` until the first `v` line, or when it had none.
+    colours: Option<Vec<Linear>>,
+    /// Vertices read so far and the first one's line.
+    count: usize,
+    first_line: usize,
+}
+
+impl ObjColours {
+    /// The values after `z` on line `line`: exactly three are a colour.
+    fn add<'a>(&mut self, rest: impl Iterator<Item = &'a [u8]>, line: usize) -> Result<(), String> {
+        let rest: Vec<&[u8]> = rest.take(4).collect();
+        let colour = if rest.len() == 3 {
+            let mut c = [0.0f32; 3];
+            for (k, (out, token)) in c.iter_mut().zip(&rest).enumerate() {
+                let v = std::str::from_utf8(token)
+                    .ok()
+                    .and_then(|t| t.parse::<f32>().ok())
+                    .ok_or_else(|| {
+                        format!(
+                            "malformed colour component '{}' in 'v x y z r g b' (expected a \
+                             number in 0..1)",
+                            show(token)
+                        )
+                    })?;
+                *out = vertex_colours::channel(v).map_err(|m| {
+                    format!(
+                        "colour component {} ({}) of 'v x y z r g b': {m} (OBJ vertex \
+                         colours are 0..1)",
+                        k + 1,
+                        ["r", "g", "b"][k]
+                    )
+                })?;
+            }
+            Some(c)
+        } else {
+            None
+        };
+        if self.count == 0 {
+            self.first_line = line;
+            self.colours = colour.map(|c| vec![c]);
+        } else {
+            match (&mut self.colours, colour) {
+                (Some(list), Some(c)) => list.push(c),
+                (None, None) => {}
+                (Some(_), None) => {
+                    return Err(format!(
+                        "this vertex has no colour 'v x y z r g b', but the first one (line \
+                         {}) has; colour every vertex or none",
+                        self.first_line
+                    ));
+                }
+                (None, Some(_)) => {
+                    return Err(format!(
+                        "this vertex has a colour, but the first one (line {}) has none; \
+                         colour every vertex or none",
+                        self.first_line
+                    ));
+                }
+            }
+        }
+        self.count += 1;
+        Ok(())
+    }
 }
 
 /// A finite `f32` coordinate, or the message of a parse error.

@@ -3,7 +3,8 @@
 //! Supported elements (others are read and skipped):
 //! - `vertex` (required): scalar properties `x`, `y`, `z` of any scalar type (`char` ..
 //!   `double`, converted to `f32`); other vertex properties (normals, colours, list
-//!   properties) are ignored.
+//!   properties) are ignored, except colours when they are asked for
+//!   ([`parse_ply_coloured`]; accepted names and types in `super::vertex_colours`).
 //! - `face` (optional): a list property `vertex_indices` or `vertex_index` with an
 //!   integer item type; polygons of any size >= 3 are fan-triangulated into
 //!   [`Mesh::triangles`].
@@ -20,7 +21,9 @@
 //! that `ply-rs-bw` would accept (repeated names, a bad `format` line, extra values on
 //! an ASCII line, data after the last element) are rejected by [`super::ply_check`].
 
+use super::vertex_colours::{self, PLY_COLOUR_NAMES};
 use super::{Mesh, MeshError, ply_check};
+use crate::colour::Linear;
 use glam::Vec3;
 use ply_rs_bw::parser::{ParseError, Parser, Reader};
 use ply_rs_bw::ply::{
@@ -35,6 +38,16 @@ const FACE_LIST_NAMES: [&str; 2] = ["vertex_indices", "vertex_index"];
 /// file whole was measured faster than streaming it through a `BufReader`, at the cost
 /// of holding the file and the vertices at once: about 200 MB for 8 M points.)
 pub(super) fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
+    Ok(parse_ply_coloured(bytes, path, false)?.0)
+}
+
+/// [`parse_ply`], plus the vertices' colours (linear) when `colours` is set and the
+/// vertex element has them.
+pub(super) fn parse_ply_coloured(
+    bytes: &[u8],
+    path: &Path,
+    colours: bool,
+) -> Result<(Mesh, Option<Vec<Linear>>), MeshError> {
     let format_err = |message: String| MeshError::Format {
         path: path.to_path_buf(),
         message,
@@ -55,6 +68,12 @@ pub(super) fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
         .read_header(&mut reader)
         .map_err(|e| wrap(path, e, true, "invalid PLY header"))?;
     check_layout(&header).map_err(format_err)?;
+    let spelling = if colours {
+        colour_layout(&header).map_err(format_err)?
+    } else {
+        None
+    };
+    let mut vertex_colours = None;
     if let Some(info) = checked.as_ref().filter(|i| i.ascii) {
         ply_check::check_ascii_lines(bytes, info, path)?;
     }
@@ -66,6 +85,28 @@ pub(super) fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
         let context = format!("element '{name}'");
         let payload_err = |e| wrap(path, e, ascii, &context);
         match name.as_str() {
+            "vertex" if spelling.is_some() => {
+                let read = Parser::<PlyColouredVertex>::new()
+                    .read_payload_for_element(&mut reader, def, &header)
+                    .map_err(payload_err)?;
+                let k = spelling.unwrap_or(0);
+                let mut linear = Vec::with_capacity(read.len());
+                for (i, v) in read.iter().enumerate() {
+                    let mut c = [0.0f32; 3];
+                    for (ch, out) in c.iter_mut().enumerate() {
+                        *out = vertex_colours::channel(v.colour[k][ch]).map_err(|m| {
+                            format_err(format!(
+                                "vertex {i} (counting from 0): colour property '{}' {m} \
+                                 (float colours are 0..1)",
+                                PLY_COLOUR_NAMES[k][ch]
+                            ))
+                        })?;
+                    }
+                    linear.push(c);
+                }
+                mesh.vertices = read.iter().map(|v| Vec3::from_array(v.position)).collect();
+                vertex_colours = Some(linear);
+            }
             "vertex" => {
                 // Same size and alignment: the collect reuses the allocation.
                 mesh.vertices = Parser::<PlyVertex>::new()
@@ -105,7 +146,65 @@ pub(super) fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
             ])
         })
         .collect::<Result<_, MeshError>>()?;
-    Ok(mesh)
+    Ok((mesh, vertex_colours))
+}
+
+/// Which spelling of the colour channels the vertex element has (an index into
+/// [`PLY_COLOUR_NAMES`]), `None` when it has none; an error for a partial triple or a
+/// type without an agreed range.
+fn colour_layout(header: &Header) -> Result<Option<usize>, String> {
+    let Some(vertex) = header.elements.get("vertex") else {
+        return Ok(None);
+    };
+    for (k, names) in PLY_COLOUR_NAMES.iter().enumerate() {
+        let found: Vec<&str> = names
+            .iter()
+            .copied()
+            .filter(|n| vertex.properties.contains_key(*n))
+            .collect();
+        if found.is_empty() {
+            continue;
+        }
+        if found.len() < 3 {
+            return Err(format!(
+                "element 'vertex' has colour properties {found:?} but not all of {names:?}"
+            ));
+        }
+        for name in names {
+            match &vertex.properties[*name].data_type {
+                PropertyType::Scalar(
+                    ScalarType::UChar | ScalarType::UShort | ScalarType::Float | ScalarType::Double,
+                ) => {}
+                other => {
+                    return Err(format!(
+                        "vertex colour property '{name}' is {}; colours must be uchar \
+                         (0..255), ushort (0..65535), float or double (0..1)",
+                        describe(other)
+                    ));
+                }
+            }
+        }
+        return Ok(Some(k));
+    }
+    Ok(None)
+}
+
+/// A property type as the PLY header spells it.
+fn describe(t: &PropertyType) -> String {
+    let scalar = |s: &ScalarType| match s {
+        ScalarType::Char => "char",
+        ScalarType::UChar => "uchar",
+        ScalarType::Short => "short",
+        ScalarType::UShort => "ushort",
+        ScalarType::Int => "int",
+        ScalarType::UInt => "uint",
+        ScalarType::Float => "float",
+        ScalarType::Double => "double",
+    };
+    match t {
+        PropertyType::Scalar(s) => format!("'{}'", scalar(s)),
+        PropertyType::List(i, s) => format!("a list ('list {} {}')", scalar(i), scalar(s)),
+    }
 }
 
 /// Checks the header declares what we read, with messages that say what is missing.
@@ -264,13 +363,18 @@ struct PlyVertex([f32; 3]);
 
 impl PlyVertex {
     fn set(&mut self, name: &str, value: f32) -> PropertyAccessResult {
+        PlyVertex::store(&mut self.0, name, value)
+    }
+
+    /// Stores `value` as coordinate `name` of `position` if it is one.
+    fn store(position: &mut [f32; 3], name: &str, value: f32) -> PropertyAccessResult {
         let axis = match name {
             "x" => 0,
             "y" => 1,
             "z" => 2,
             _ => return PropertyAccessResult::Ignored,
         };
-        self.0[axis] = value;
+        position[axis] = value;
         PropertyAccessResult::Set
     }
 }
@@ -302,6 +406,60 @@ impl PropertyAccess for PlyVertex {
     }
     fn set_double(&mut self, name: &str, value: f64) -> PropertyAccessResult {
         self.set(name, value as f32)
+    }
+}
+
+/// Position and colour of a `vertex` element when colours are asked for: each
+/// spelling of [`PLY_COLOUR_NAMES`] as fractions (integer types divided by their
+/// maximum; types without a range are rejected by [`colour_layout`] before reading).
+#[derive(Clone, Copy, Default)]
+struct PlyColouredVertex {
+    position: [f32; 3],
+    colour: [[f32; 3]; 3],
+}
+
+impl PlyColouredVertex {
+    fn set(&mut self, name: &str, value: f32, fraction: f32) -> PropertyAccessResult {
+        if let PropertyAccessResult::Set = PlyVertex::store(&mut self.position, name, value) {
+            return PropertyAccessResult::Set;
+        }
+        for (k, names) in PLY_COLOUR_NAMES.iter().enumerate() {
+            if let Some(ch) = names.iter().position(|n| *n == name) {
+                self.colour[k][ch] = fraction;
+                return PropertyAccessResult::Set;
+            }
+        }
+        PropertyAccessResult::Ignored
+    }
+}
+
+impl PropertyAccess for PlyColouredVertex {
+    fn new() -> Self {
+        Self::default()
+    }
+    fn set_char(&mut self, name: &str, value: i8) -> PropertyAccessResult {
+        self.set(name, f32::from(value), f32::NAN)
+    }
+    fn set_uchar(&mut self, name: &str, value: u8) -> PropertyAccessResult {
+        self.set(name, f32::from(value), f32::from(value) / 255.0)
+    }
+    fn set_short(&mut self, name: &str, value: i16) -> PropertyAccessResult {
+        self.set(name, f32::from(value), f32::NAN)
+    }
+    fn set_ushort(&mut self, name: &str, value: u16) -> PropertyAccessResult {
+        self.set(name, f32::from(value), f32::from(value) / 65535.0)
+    }
+    fn set_int(&mut self, name: &str, value: i32) -> PropertyAccessResult {
+        self.set(name, value as f32, f32::NAN)
+    }
+    fn set_uint(&mut self, name: &str, value: u32) -> PropertyAccessResult {
+        self.set(name, value as f32, f32::NAN)
+    }
+    fn set_float(&mut self, name: &str, value: f32) -> PropertyAccessResult {
+        self.set(name, value, value)
+    }
+    fn set_double(&mut self, name: &str, value: f64) -> PropertyAccessResult {
+        self.set(name, value as f32, value as f32)
     }
 }
 

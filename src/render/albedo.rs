@@ -1,5 +1,6 @@
 //! Colour from the data at a hit: the object's smooth colour field
-//! ([`crate::eval::colour`]) as the albedo, shaded by the MatCap.
+//! ([`crate::eval::colour`]) as the albedo, or for `color_by = "normal"` the hit's
+//! normal as a colour ([`crate::colour::by_geometry`]), shaded by the MatCap.
 //!
 //! Shading: the MatCap's colour is reduced to its luminance (linear light), which scales
 //! the albedo; a MatCap's lit areas are about 0.8, so the factor is divided by
@@ -9,6 +10,7 @@
 
 use super::object::TraceObject;
 use super::tracer::Hit;
+use crate::colour::by_geometry::normal_colour;
 use crate::colour::{Linear, SetColours, srgb8_to_linear, to_srgb8};
 use crate::eval::colour::colour_at;
 
@@ -24,6 +26,9 @@ pub fn shade_hit(objects: &[TraceObject], hit: &Hit, shaded: [u8; 3]) -> [u8; 3]
     let Some(colours) = &obj.colours else {
         return shaded;
     };
+    if colours.from_normal {
+        return tint(shaded, normal_colour(hit.normal));
+    }
     let sets = obj.set_refs();
     let cols: Vec<&SetColours> = colours.sets.iter().collect();
     match colour_at(&sets, &cols, hit.point, &obj.params) {

@@ -5,7 +5,8 @@
 
 use super::object::TraceObject;
 use crate::camera::{Camera, CameraError};
-use crate::colour::{ObjectColours, SetColours};
+use crate::colour::by_geometry::height_colours;
+use crate::colour::{GeometryColorBy, ObjectColours, SetColours};
 use crate::eval::EvalParams;
 use crate::matcap::{MatCap, MatCapError};
 use crate::mesh::{Aabb, Mesh, MeshError};
@@ -104,6 +105,19 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
                 vertex_colours = cloud.colours;
                 cloud.mesh
             }
+            Geometry::Mesh(path) if obj.colour.is_some_and(|c| c.by == GeometryColorBy::Vertex) => {
+                let (mesh, colours) = Mesh::load_with_vertex_colours(path).map_err(mesh_error)?;
+                vertex_colours = Some(colours.ok_or_else(|| BuildError::Invalid {
+                    scene: name.clone(),
+                    object: k,
+                    message: format!(
+                        "object[{k}].color_by = \"vertex\", but {} has no vertex colours (PLY: \
+                         red, green, blue vertex properties; OBJ: 'v x y z r g b')",
+                        path.display()
+                    ),
+                })?);
+                mesh
+            }
             Geometry::Mesh(path) => Mesh::load(path).map_err(mesh_error)?,
             Geometry::Generator(g) => g.build().map_err(|source| BuildError::Generator {
                 scene: name.clone(),
@@ -181,6 +195,9 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
             });
             sets.push(set);
         }
+        if let Some(c) = obj.colour.filter(|c| c.by == GeometryColorBy::Height) {
+            vertex_colours = Some(height_colours(&mesh, c.colormap));
+        }
         let colours = vertex_colours.map(|vc| {
             let t = Instant::now();
             let c = ObjectColours {
@@ -188,6 +205,7 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
                     .iter()
                     .map(|s| SetColours::build(s, &mesh, &vc))
                     .collect(),
+                from_normal: false,
             };
             steps.push(BuildStep {
                 object: k,
@@ -211,7 +229,13 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
             seconds: 0.0,
         });
         let mut object = TraceObject::new(sets, params);
-        object.colours = colours;
+        object.colours = match obj.colour {
+            Some(c) if c.by == GeometryColorBy::Normal => Some(ObjectColours {
+                sets: Vec::new(),
+                from_normal: true,
+            }),
+            _ => colours,
+        };
         objects.push(object);
         // Each distinct MatCap is built or loaded once.
         let shader = match loaded_matcaps.iter().find(|(s, _)| *s == obj.matcap) {

@@ -139,6 +139,9 @@ pub struct Object {
     /// Lidar filters, origin and colour (`classes`, `crop`, `color_by`, ...); only for
     /// `.las` / `.laz` meshes, the default everywhere else.
     pub las: LasOptions,
+    /// `color_by = "vertex" | "height" | "normal"` (any object); lidar attributes are in
+    /// `las`.
+    pub colour: Option<crate::colour::GeometryColouring>,
 }
 
 impl Object {

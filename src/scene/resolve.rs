@@ -202,7 +202,7 @@ impl Resolver<'_> {
         let name = format!("object[{i}]");
         let span = raw.span();
         let raw = raw.into_inner();
-        let las = self.lidar(&name, &raw)?;
+        let (las, colour) = self.lidar(&name, &raw)?;
         let geometry = match (raw.mesh, raw.generator) {
             (Some(_), Some(g)) => {
                 return Err(self.invalid(
@@ -262,6 +262,7 @@ impl Resolver<'_> {
             transform,
             matcap,
             las,
+            colour,
         })
     }
 

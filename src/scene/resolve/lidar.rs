@@ -1,19 +1,27 @@
 //! The lidar keys of an `[[object]]`: filters (`classes`, `exclude_classes`, `returns`,
 //! `crop`, `thin`), `origin`, and colour (`color_by`, `colormap`), resolved into
-//! [`LasOptions`]. Values that make no sense on their own (a class above 255, a voxel
-//! of size 0, an unknown name) are rejected here with their location; whether the
-//! object is a lidar file at all is checked by the validator.
+//! [`LasOptions`]; `color_by` also takes the colourings of any object (`vertex`,
+//! `height`, `normal`: [`GeometryColouring`]). Values that make no sense on their own (a
+//! class above 255, a voxel of size 0, an unknown name) are rejected here with their
+//! location; whether the object is a lidar file at all is checked by the validator.
 
 use super::super::error::SceneError;
 use super::super::raw::{RawCrop, RawObject, RawThin};
 use super::Resolver;
-use crate::colour::Colormap;
+use crate::colour::{Colormap, GeometryColorBy, GeometryColouring};
 use crate::las::{ColorBy, LasFilters, LasOptions, NOISE_CLASSES, Returns, Thin};
 use glam::DVec3;
 use toml::Spanned;
 
+/// A lidar attribute and its colormap, or a geometric colouring (at most one is set).
+type ColourKeys = (Option<ColorBy>, Option<Colormap>, Option<GeometryColouring>);
+
 impl Resolver<'_> {
-    pub(super) fn lidar(&mut self, name: &str, raw: &RawObject) -> Result<LasOptions, SceneError> {
+    pub(super) fn lidar(
+        &mut self,
+        name: &str,
+        raw: &RawObject,
+    ) -> Result<(LasOptions, Option<GeometryColouring>), SceneError> {
         let classes = match &raw.classes {
             None => None,
             Some(v) => Some(self.class_list(name, "classes", v)?),
@@ -54,22 +62,8 @@ impl Resolver<'_> {
                 Some(v)
             }
         };
-        let color_by = match &raw.color_by {
-            None => None,
-            Some(v) => Some(self.named(name, "color_by", v, ColorBy::from_name, || {
-                format!("must be {}", ColorBy::NAMES)
-            })?),
-        };
-        let colormap = match &raw.colormap {
-            None => None,
-            Some(v) => Some(self.named(name, "colormap", v, Colormap::from_name, || {
-                format!(
-                    "names an unknown colormap; expected one of {}",
-                    Colormap::names()
-                )
-            })?),
-        };
-        Ok(LasOptions {
+        let (color_by, colormap, geometry) = self.colour_keys(name, raw)?;
+        let options = LasOptions {
             filters: LasFilters {
                 classes,
                 exclude_classes,
@@ -80,7 +74,87 @@ impl Resolver<'_> {
             color_by,
             colormap,
             origin,
-        })
+        };
+        Ok((options, geometry))
+    }
+
+    /// `color_by` and `colormap`: a lidar attribute (with its colormap, checked against
+    /// the file by the validator) or a geometric colouring for any object.
+    fn colour_keys(&mut self, name: &str, raw: &RawObject) -> Result<ColourKeys, SceneError> {
+        let colormap = match &raw.colormap {
+            None => None,
+            Some(v) => Some(self.named(name, "colormap", v, Colormap::from_name, || {
+                format!(
+                    "names an unknown colormap; expected one of {}",
+                    Colormap::names()
+                )
+            })?),
+        };
+        let Some(v) = &raw.color_by else {
+            if let Some(map) = &raw.colormap {
+                let key = format!("{name}.colormap");
+                return Err(self.invalid(
+                    map.span(),
+                    &key,
+                    format!(
+                        "{key} colours a scalar: give color_by = \"height\" (or \"intensity\" \
+                         or \"elevation\" for lidar files) with it"
+                    ),
+                ));
+            }
+            return Ok((None, None, None));
+        };
+        let key = format!("{name}.color_by");
+        if let Some(by) = GeometryColorBy::from_name(v.get_ref()) {
+            self.record(&key, v.span(), &Some(by));
+            let is_lidar = raw
+                .mesh
+                .as_ref()
+                .is_some_and(|m| crate::las::is_lidar_path(std::path::Path::new(m.get_ref())));
+            if by == GeometryColorBy::Vertex && (is_lidar || raw.mesh.is_none()) {
+                let why = if is_lidar {
+                    "a lidar file's colours are color_by = \"rgb\""
+                } else {
+                    "a generated shape has no vertex colours; use \"height\" or \"normal\""
+                };
+                return Err(self.invalid(
+                    v.span(),
+                    &key,
+                    format!("{key} = \"vertex\" reads a PLY or OBJ file's colours: {why}"),
+                ));
+            }
+            if let (Some(map), false) = (&raw.colormap, by == GeometryColorBy::Height) {
+                let key = format!("{name}.colormap");
+                return Err(self.invalid(
+                    map.span(),
+                    &key,
+                    format!(
+                        "{key} colours a scalar: it needs color_by = \"height\" (got color_by \
+                         = \"{}\")",
+                        by.name()
+                    ),
+                ));
+            }
+            let colouring = GeometryColouring {
+                by,
+                colormap: colormap.unwrap_or(Colormap::Viridis),
+            };
+            return Ok((None, None, Some(colouring)));
+        }
+        let Some(by) = ColorBy::from_name(v.get_ref()) else {
+            return Err(self.invalid(
+                v.span(),
+                &key,
+                format!(
+                    "{key} must be {} (any object) or {} (lidar files) (got \"{}\")",
+                    GeometryColorBy::NAMES,
+                    ColorBy::NAMES,
+                    v.get_ref()
+                ),
+            ));
+        };
+        self.record(&key, v.span(), &Some(by));
+        Ok((Some(by), colormap, None))
     }
 
     /// A name looked up by `parse`, recorded under `name.key` (as an `Option`, the way
