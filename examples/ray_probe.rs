@@ -34,17 +34,57 @@ fn main() {
             let mut st = RayStats::default();
             let (s0, _) = tr.field(o, &mut st);
             let r = tr.trace(o, d, s0);
-            println!("relax {relax}: hit {:?} evals {} bound {}", r.hit.map(|h| h.t), r.stats.evals, r.stats.coarse_evals);
+            println!(
+                "relax {relax}: hit {:?} evals {} bound {}",
+                r.hit.map(|h| h.t),
+                r.stats.evals,
+                r.stats.coarse_evals
+            );
             if let Some(h) = r.hit {
                 let mut line = String::new();
                 for k in -20..=20 {
                     let t = h.t + k as f64 * 0.5 * eps;
                     let mut st = RayStats::default();
-                    line += &format!(" {:.2}/{:.2}", tr.field(o + t * d, &mut st).0 / eps, exact(o + t * d) / eps);
+                    line += &format!(
+                        " {:.2}/{:.2}",
+                        tr.field(o + t * d, &mut st).0 / eps,
+                        exact(o + t * d) / eps
+                    );
                 }
                 println!("  s_BH/s_exact around the hit, steps of eps/2 (in eps): {line}");
             }
         }
+        return;
+    }
+    if args.get(4).map(String::as_str) == Some("evalstats") {
+        let mut sum = [0f64; 5];
+        let mut n = 0.0;
+        let tol = (0.005 * obj.params.alpha * eps).min(1e-3);
+        for py in (0..h).step_by(2) {
+            for px in (0..w).step_by(2) {
+                let (o, d) = cam.ray(px, py);
+                let Some(hit) = tracer.trace(o, d, 0.0).hit else {
+                    continue;
+                };
+                for back in [0.0, 4.0, 16.0] {
+                    let x = hit.point - back * eps * d;
+                    let e = obj.evaluate(&sets, x, obj.params.alpha, None, tol, false);
+                    let st = e.stats;
+                    sum[0] += st.exact as f64;
+                    sum[1] += st.far as f64;
+                    sum[2] += st.pruned as f64;
+                    sum[3] += st.nodes as f64;
+                    n += 1.0;
+                }
+            }
+        }
+        println!(
+            "per full eval near hits: exact {:.1} far {:.1} pruned {:.1} nodes {:.1}",
+            sum[0] / n,
+            sum[1] / n,
+            sum[2] / n,
+            sum[3] / n
+        );
         return;
     }
     let mut printed = 0;

@@ -588,7 +588,9 @@ mod tests {
         };
         let (mut plain_n, mut relaxed_n) = (0, 0);
         for _ in 0..2000 {
-            let zeros: Vec<(f64, f64)> = (0..4).map(|_| (1.0 + 99.0 * rnd(), 0.02 + 0.98 * rnd())).collect();
+            let zeros: Vec<(f64, f64)> = (0..4)
+                .map(|_| (1.0 + 99.0 * rnd(), 0.02 + 0.98 * rnd()))
+                .collect();
             let first = zeros.iter().map(|z| z.0).fold(f64::INFINITY, f64::min);
             let f = |t: f64| {
                 zeros
@@ -602,9 +604,16 @@ mod tests {
             let eps = 1e-3;
             for relax in [false, true] {
                 let (t, n) = march(lower, eps, relax);
-                assert!(t <= first, "passed the first zero {first} at {t} (relax {relax})");
+                assert!(
+                    t <= first,
+                    "passed the first zero {first} at {t} (relax {relax})"
+                );
                 // The sample there was at most eps, and at least 60% of the field.
-                assert!(f(t) <= eps / 0.6, "stopped at {t} where the field is {}", f(t));
+                assert!(
+                    f(t) <= eps / 0.6,
+                    "stopped at {t} where the field is {}",
+                    f(t)
+                );
                 if relax {
                     relaxed_n += n;
                 } else {
