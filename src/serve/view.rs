@@ -199,7 +199,11 @@ impl ViewRequest {
             o.max_alpha = alpha_spec(&name, "max_alpha", v.max_alpha, v.max_alpha_rel)?;
             o.matcap = matcap(&name, &v.matcap, &o.matcap, folder)?;
         }
-        scene.validate().map_err(|e| bad(e.to_string()))?;
+        // The values come from the request, not the file: validated without the file's
+        // name, so no message points at a line of it.
+        let mut unnamed = scene.clone();
+        unnamed.path = std::path::PathBuf::new();
+        unnamed.validate().map_err(|e| bad(e.to_string()))?;
         Ok(scene)
     }
 
