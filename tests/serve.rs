@@ -519,6 +519,9 @@ fn a_newer_view_cancels_an_older_render() {
 fn a_saved_scene_renders_the_image_the_server_rendered() {
     let dir = fixture();
     let s = Served::start(dir.path(), &["scene.toml", "--save", "saved.toml"]);
+    let (_, _, info) = s.request("GET", "/api/scene", b"");
+    let info: Value = serde_json::from_slice(&info).unwrap();
+    assert_eq!(info["save_as"], "saved.toml", "the page's suggested name");
     let mut view = s.view();
     view["camera"]["origin"] = json!([2.0, 1.5, 2.5]);
     view["objects"][0]["alpha"] = json!(25.0);

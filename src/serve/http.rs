@@ -100,7 +100,11 @@ fn scene_info(state: &State) -> Reply {
         .iter()
         .map(|o| match &o.geometry {
             crate::scene::Geometry::Mesh(p) => save::relative_path(p, state.folder.root()),
-            crate::scene::Geometry::Generator(g) => format!("{g:?}"),
+            crate::scene::Geometry::Generator(g) => {
+                let kind = serde_json::to_value(g).ok();
+                let kind = kind.as_ref().and_then(|v| v["kind"].as_str());
+                format!("generator {}", kind.unwrap_or("?"))
+            }
         })
         .collect();
     let mut matcaps = vec!["normal"];

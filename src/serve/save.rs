@@ -27,7 +27,14 @@ fn alpha_into(t: &mut Table, key: &str, a: AlphaSpec) {
 /// `path` written relative to the folder `from` when both resolve (`../data/x.obj`),
 /// else absolute.
 pub fn relative_path(path: &Path, from: &Path) -> String {
-    let (Ok(path), Ok(from)) = (path.canonicalize(), from.canonicalize()) else {
+    // A file not written yet resolves through its folder.
+    let real = path
+        .canonicalize()
+        .or_else(|e| match (path.parent(), path.file_name()) {
+            (Some(dir), Some(name)) => dir.canonicalize().map(|d| d.join(name)),
+            _ => Err(e),
+        });
+    let (Ok(path), Ok(from)) = (real, from.canonicalize()) else {
         return path.display().to_string();
     };
     let a: Vec<Component> = path.components().collect();
