@@ -504,6 +504,29 @@ fn a_newer_view_cancels_an_older_render() {
     let st = status(&s);
     assert_eq!(st["renders_cancelled"], 1, "{st}");
     assert_eq!(st["renders_finished"], 1, "{st}");
+    // A "keep" render (the full PNG download) is not cancelled by newer views.
+    let kept = with(
+        &view,
+        json!({"width": 1024, "height": 1024, "beta": 0.0, "keep": true}),
+    );
+    let kept =
+        std::thread::spawn(move || http(addr, "POST", "/api/render", kept.to_string().as_bytes()));
+    let start = Instant::now();
+    while status(&s)["renders_started"].as_u64() != Some(3) {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "the kept render did not start"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert_eq!(
+        s.post("/api/render", &with(&view, json!({"scale": 8}))).0,
+        200
+    );
+    let (kept_status, _, body) = kept.join().unwrap();
+    assert_eq!(kept_status, 200, "{}", text(&body));
+    assert_eq!(png(&body).dimensions(), (1024, 1024));
+    assert_eq!(status(&s)["renders_cancelled"], 1);
     // Parameter changes reuse the build; a new primitive kind rebuilds it.
     assert_eq!(st["builds"], 1, "{st}");
     let mut v = with(&view, json!({"scale": 8}));

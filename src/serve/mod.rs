@@ -288,7 +288,10 @@ fn respond(request: tiny_http::Request, reply: http::Reply) {
     let header = |name: &str, value: &str| {
         tiny_http::Header::from_bytes(name.as_bytes(), value.as_bytes()).ok()
     };
-    let mut response = tiny_http::Response::from_data(reply.body).with_status_code(reply.status);
+    // A Content-Length instead of chunks, whatever the size (the body is in memory).
+    let mut response = tiny_http::Response::from_data(reply.body)
+        .with_status_code(reply.status)
+        .with_chunked_threshold(usize::MAX);
     let headers = [
         ("Content-Type", reply.content_type.to_string()),
         ("Cache-Control", "no-store".into()),
