@@ -89,6 +89,7 @@ fn lock(m: &Mutex<Option<Cached>>) -> MutexGuard<'_, Option<Cached>> {
         // A job panicked while holding the scene: it may be half updated.
         let mut guard = poisoned.into_inner();
         *guard = None;
+        m.clear_poison();
         guard
     })
 }
@@ -321,6 +322,32 @@ fn depth_image(r: &Rendered, background: [u8; 3]) -> image::RgbImage {
 mod tests {
     use super::*;
     use crate::render::image::ImageStats;
+
+    #[test]
+    fn a_panic_while_holding_the_build_drops_it() {
+        let scene = crate::scene::Scene::from_str(
+            "[camera]\norigin = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\n[[object]]\ngenerator = { kind = \"hex_torus\" }\nprimitives = \"edges\"\nalpha = 20.0\n",
+            std::path::Path::new("t.toml"),
+        )
+        .unwrap();
+        let jobs = Jobs::default();
+        jobs.warm(&scene).unwrap();
+        assert_eq!(jobs.diagonals().len(), 1);
+        let poisoned = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            let _guard = jobs.cache.lock().unwrap();
+            panic!("a render panicked");
+        }));
+        assert!(poisoned.is_err() && jobs.cache.is_poisoned());
+        // The next job finds no build (it may be half updated) and builds again.
+        assert!(jobs.diagonals().is_empty());
+        jobs.warm(&scene).unwrap();
+        assert_eq!(jobs.counters.builds.load(Ordering::Relaxed), 2);
+        // Once, not at every job after.
+        assert!(!jobs.cache.is_poisoned());
+        jobs.warm(&scene).unwrap();
+        assert_eq!(jobs.diagonals().len(), 1);
+        assert_eq!(jobs.counters.builds.load(Ordering::Relaxed), 2);
+    }
 
     #[test]
     fn depth_view_orders_near_to_far() {

@@ -244,25 +244,28 @@ fn handle(state: &State, mut request: tiny_http::Request) {
     let url = request.url().to_string();
     let reply = match read_body(&mut request) {
         Err(e) => http::Reply::error(&e),
-        Ok(body) => {
-            let run = std::panic::AssertUnwindSafe(|| http::route(state, &method, &url, &body));
-            match std::panic::catch_unwind(run) {
-                Ok(Ok(reply)) => reply,
-                Ok(Err(e)) => http::Reply::error(&e),
-                Err(panic) => {
-                    let message = panic
-                        .downcast_ref::<String>()
-                        .map(String::as_str)
-                        .or_else(|| panic.downcast_ref::<&str>().copied())
-                        .unwrap_or("unknown panic");
-                    http::Reply::error(&ServeError::Internal(format!(
-                        "the request failed (the server goes on): {message}"
-                    )))
-                }
-            }
-        }
+        Ok(body) => guarded(|| http::route(state, &method, &url, &body)),
     };
     respond(request, reply);
+}
+
+/// Runs a request's work; an error becomes its status, a panic a 500 (the server goes
+/// on).
+fn guarded(work: impl FnOnce() -> Result<http::Reply, ServeError>) -> http::Reply {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(work)) {
+        Ok(Ok(reply)) => reply,
+        Ok(Err(e)) => http::Reply::error(&e),
+        Err(panic) => {
+            let message = panic
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| panic.downcast_ref::<&str>().copied())
+                .unwrap_or("unknown panic");
+            http::Reply::error(&ServeError::Internal(format!(
+                "the request failed (the server goes on): {message}"
+            )))
+        }
+    }
 }
 
 fn read_body(request: &mut tiny_http::Request) -> Result<Vec<u8>, ServeError> {
@@ -340,4 +343,22 @@ pub fn scene_for_mesh(path: &Path) -> Result<Scene, crate::mesh::MeshError> {
     );
     scene.path = path.to_path_buf();
     Ok(scene)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panicking_request_answers_500() {
+        let reply = guarded(|| panic!("boom in a render"));
+        assert_eq!(reply.status, 500);
+        let body = String::from_utf8(reply.body).unwrap();
+        assert_eq!(
+            body,
+            "the request failed (the server goes on): boom in a render"
+        );
+        let reply = guarded(|| Err(ServeError::Cancelled));
+        assert_eq!(reply.status, 409);
+    }
 }
