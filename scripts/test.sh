@@ -6,7 +6,8 @@
 # bindings and pyo3/numpy are compiled on top of the Rust tests' build), and runs
 # pytest on tests/python. trimesh (with rtree, scipy) is installed when the package index
 # provides it within two minutes; without it the comparison with trimesh skips and says
-# why. Exits non-zero if either suite fails.
+# why. So is playwright (the browser test drives the system's Chromium with it; no
+# browser is downloaded). Exits non-zero if either suite fails.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
@@ -20,6 +21,8 @@ if "$python" -m venv "$venv" && "$venv/bin/python" -m pip install --quiet --upgr
     "$venv/bin/python" -m pip install --quiet . pytest numpy; then
     timeout 120 "$venv/bin/python" -m pip install --quiet trimesh rtree scipy ||
         echo "note: trimesh/rtree/scipy not installed; the trimesh comparison will skip"
+    timeout 120 "$venv/bin/python" -m pip install --quiet playwright ||
+        echo "note: playwright not installed; the browser test will skip"
     SMOOTHTRACE_BIN="$PWD/target/release/smoothtrace" \
         "$venv/bin/python" -m pytest -p no:cacheprovider -rs tests/python
     py=$?

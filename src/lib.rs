@@ -26,3 +26,4 @@ pub mod procedural;
 pub mod render;
 pub mod reports;
 pub mod scene;
+pub mod serve;

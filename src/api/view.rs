@@ -68,6 +68,7 @@ pub fn render_object(object: TraceObject, image: &ImageRequest) -> Result<Render
     let shader = MatCap::from_spec(&image.matcap)?;
     let render = RenderSettings::default();
     let bounds = object.bounds;
+    let diagonal = bounds.diagonal();
     let built = BuiltScene {
         objects: vec![object],
         shaders: vec![shader],
@@ -75,6 +76,7 @@ pub fn render_object(object: TraceObject, image: &ImageRequest) -> Result<Render
         epsilon: render.epsilon.resolve(bounds.diagonal()),
         bounds,
         steps: Vec::new(),
+        diagonals: vec![diagonal],
     };
     let rendered = with_threads(image.threads, || {
         pipeline::render_built(&built, render.max_steps, image.background, |o| o, &|_| {})

@@ -9,6 +9,7 @@ mod outputs;
 mod progress;
 mod query;
 mod render;
+mod serve;
 mod stability;
 mod sweep;
 
@@ -40,6 +41,8 @@ enum Command {
     Stability(stability::StabilityArgs),
     /// Compute a distance field on a voxel grid (.npy), exact or smooth.
     Field(field::FieldArgs),
+    /// Build a scene in the browser: a local web page with a live, progressive view.
+    Serve(serve::ServeArgs),
 }
 
 /// Parses the command line, runs the command, and maps errors to exit status 2.
@@ -52,6 +55,7 @@ pub fn run() -> ExitCode {
         Command::Sweep(a) => sweep::run(a),
         Command::Stability(a) => stability::run(a),
         Command::Field(a) => field::run(a),
+        Command::Serve(a) => serve::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -29,11 +29,11 @@ pub use torus::torus;
 pub use validate::MAX_PRIMITIVES;
 
 use crate::mesh::Mesh;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use validate::Check;
 
 /// A procedural shape and its parameters, as written in a scene file.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Generator {
     /// Triangle torus in the xz plane (axis y). Default 32 x 18 quads = 1152 triangles.

@@ -81,6 +81,9 @@ pub struct BuiltScene {
     /// Union of the objects' bounding boxes.
     pub bounds: Aabb,
     pub steps: Vec<BuildStep>,
+    /// Each object's bounding-box diagonal after its transform (what `alpha_rel` is
+    /// relative to).
+    pub diagonals: Vec<f64>,
 }
 
 /// Builds every object of `scene`.
@@ -90,6 +93,7 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
     let mut objects = Vec::new();
     let mut shaders: Vec<MatCap> = Vec::new();
     let mut loaded_matcaps: Vec<(crate::matcap::MatCapSpec, MatCap)> = Vec::new();
+    let mut diagonals = Vec::new();
     for (k, obj) in scene.objects.iter().enumerate() {
         let t = Instant::now();
         let mesh_error = |source| BuildError::Mesh {
@@ -147,31 +151,8 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
             seconds: t.elapsed().as_secs_f64(),
         });
         let diag = mesh.bounds().diagonal();
-        let invalid = |message: String| BuildError::Invalid {
-            scene: name.clone(),
-            object: k,
-            message,
-        };
-        let alpha = obj.alpha.resolve(diag).ok_or_else(|| {
-            invalid(format!(
-                "{} needs an object with a non-zero bounding box (its diagonal is {diag}); give an absolute alpha",
-                obj.alpha.key()
-            ))
-        })?;
-        let max_alpha = obj.max_alpha_or_alpha().resolve(diag).ok_or_else(|| {
-            invalid(format!(
-                "max_alpha_rel needs a non-zero bounding box (diagonal {diag})"
-            ))
-        })?;
-        for (key, v) in [("alpha", alpha), ("max_alpha", max_alpha)] {
-            if let Some(problem) = crate::limits::alpha_problem(v) {
-                return Err(invalid(format!(
-                    "{key} {problem} (resolved from {} = {} over the diagonal {diag})",
-                    obj.alpha.key(),
-                    obj.alpha.value()
-                )));
-            }
-        }
+        let (alpha, max_alpha) = object_alphas(&name, k, obj, diag)?;
+        diagonals.push(diag);
         let mut sets = Vec::new();
         for &kind in &obj.primitives {
             let t = Instant::now();
@@ -270,7 +251,46 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
         epsilon: scene.render.epsilon.resolve(bounds.diagonal()),
         bounds,
         steps,
+        diagonals,
     })
+}
+
+/// Object `k`'s alpha and max_alpha in 1/world units, resolved against `diag` (its
+/// bounding-box diagonal after its transform) and checked against the alpha limits.
+/// `scene` names the scene in messages. An interactive view that changes alpha calls it
+/// again with [`BuiltScene::diagonals`] instead of rebuilding.
+pub fn object_alphas(
+    scene: &str,
+    k: usize,
+    obj: &crate::scene::Object,
+    diag: f64,
+) -> Result<(f64, f64), BuildError> {
+    let invalid = |message: String| BuildError::Invalid {
+        scene: scene.to_string(),
+        object: k,
+        message,
+    };
+    let alpha = obj.alpha.resolve(diag).ok_or_else(|| {
+        invalid(format!(
+            "{} needs an object with a non-zero bounding box (its diagonal is {diag}); give an absolute alpha",
+            obj.alpha.key()
+        ))
+    })?;
+    let max_alpha = obj.max_alpha_or_alpha().resolve(diag).ok_or_else(|| {
+        invalid(format!(
+            "max_alpha_rel needs a non-zero bounding box (diagonal {diag})"
+        ))
+    })?;
+    for (key, v) in [("alpha", alpha), ("max_alpha", max_alpha)] {
+        if let Some(problem) = crate::limits::alpha_problem(v) {
+            return Err(invalid(format!(
+                "{key} {problem} (resolved from {} = {} over the diagonal {diag})",
+                obj.alpha.key(),
+                obj.alpha.value()
+            )));
+        }
+    }
+    Ok((alpha, max_alpha))
 }
 
 /// `--verbose` lines of a lidar file: what was read, each filter's count, the origin.

@@ -16,6 +16,7 @@
 //! divided by the scene's bounding-box diagonal.
 
 mod error;
+mod json;
 mod raw;
 mod resolve;
 mod transform;
@@ -238,7 +239,8 @@ impl CameraSettings {
 }
 
 impl Scene {
-    /// Reads, parses and validates a scene file. A missing or unreadable file is an error
+    /// Reads, parses and validates a scene file: TOML, or a published JSON scene when
+    /// the name ends in `.json` (see `json`). A missing or unreadable file is an error
     /// naming it.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let read_err = |source| SceneError::Read {
@@ -255,6 +257,14 @@ impl Scene {
                 ),
             ))
         })?;
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        {
+            let scene = json::parse(&text, path)?;
+            scene.validate()?;
+            return Ok(scene);
+        }
         Scene::from_str(&text, path)
     }
 
