@@ -108,6 +108,7 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 MatCapSpec::parse(&o.matcap, dir)
             },
             las: LasOptions::default(),
+            colour: None,
         })
         .collect();
     let mut scene = Scene::new(camera, objects);

@@ -336,6 +336,7 @@ pub fn scene_for_mesh(path: &Path) -> Result<Scene, crate::mesh::MeshError> {
         transform: Default::default(),
         matcap: Default::default(),
         las: Default::default(),
+        colour: None,
     };
     let mut scene = Scene::new(
         CameraSettings::looking_at(DVec3::Z, DVec3::ZERO),

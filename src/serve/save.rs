@@ -118,6 +118,12 @@ pub fn scene_toml(scene: &Scene, folder: &Path) -> Result<String, SaveError> {
             other => other.to_string(),
         };
         t.insert("matcap".into(), matcap.into());
+        if let Some(c) = &o.colour {
+            t.insert("color_by".into(), c.by.name().into());
+            if c.by == crate::colour::GeometryColorBy::Height {
+                t.insert("colormap".into(), c.colormap.name().into());
+            }
+        }
         if !o.transform.is_identity() {
             let mut tr = Table::new();
             tr.insert("scale".into(), vec3(o.transform.scale));
@@ -180,6 +186,13 @@ alpha_rel = 500.0
 max_alpha = 600.0
 matcap = "gold"
 transform = { scale = 2.0, rotate = [0.0, 30.0, 0.0], translate = [1.0, 0.0, 0.0] }
+color_by = "height"
+colormap = "magma"
+[[object]]
+generator = { kind = "torus" }
+primitives = ["points"]
+alpha_rel = 50.0
+color_by = "normal"
 "##;
         let a = Scene::from_str(text, &dir.path().join("a.toml")).unwrap();
         let saved = scene_toml(&a, dir.path()).unwrap();
