@@ -43,8 +43,16 @@ struct RangeBounds {
     centroids: Aabb,
 }
 
-/// Builds a BVH over primitives given their bounds and centroids.
+/// Builds a BVH over primitives given their bounds and centroids, with its wide form.
 pub fn build(bounds: &[Aabb], centroids: &[Vec3], options: BuildOptions) -> Bvh {
+    let mut bvh = build_binary(bounds, centroids, options);
+    bvh.make_wide();
+    bvh
+}
+
+/// Builds the binary tree only: call [`Bvh::make_wide`] before evaluating with it
+/// (after dropping the build's inputs, to keep the peak memory down).
+pub fn build_binary(bounds: &[Aabb], centroids: &[Vec3], options: BuildOptions) -> Bvh {
     assert_eq!(bounds.len(), centroids.len());
     if bounds.is_empty() {
         return Bvh::default();
@@ -79,12 +87,10 @@ pub fn build(bounds: &[Aabb], centroids: &[Vec3], options: BuildOptions) -> Bvh 
             },
         );
     let nodes = build_range(&input, &mut order, 0, rb);
-    let (wide_root, wide) = super::wide::collapse(&nodes);
     Bvh {
         nodes,
         order,
-        wide_root,
-        wide,
+        ..Bvh::default()
     }
 }
 

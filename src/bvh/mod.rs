@@ -10,7 +10,7 @@ mod build;
 mod validate;
 pub mod wide;
 
-pub use build::{BuildOptions, build};
+pub use build::{BuildOptions, build, build_binary};
 pub use validate::validate;
 pub use wide::{Node4, Root};
 
@@ -87,6 +87,11 @@ impl Bvh {
 
     pub fn leaf_count(&self) -> usize {
         self.nodes.iter().filter(|n| n.is_leaf()).count()
+    }
+
+    /// Builds the 4-wide form the smooth-distance traversal walks (`wide`).
+    pub fn make_wide(&mut self) {
+        (self.wide_root, self.wide) = wide::collapse(&self.nodes);
     }
 
     pub fn memory_bytes(&self) -> usize {

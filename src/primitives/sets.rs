@@ -44,9 +44,11 @@ impl<P: Primitive> PrimitiveSet<P> {
         let t = Instant::now();
         let bounds: Vec<Aabb> = prims.par_iter().map(|p| p.bounds()).collect();
         let centroids: Vec<_> = prims.par_iter().map(|p| p.centroid()).collect();
-        let bvh = bvh::build(&bounds, &centroids, options);
+        let mut bvh = bvh::build_binary(&bounds, &centroids, options);
         drop((bounds, centroids));
         let sorted: Vec<P> = bvh.order.par_iter().map(|&i| prims[i as usize]).collect();
+        drop(prims);
+        bvh.make_wide();
         let bounds = bvh
             .nodes
             .first()
