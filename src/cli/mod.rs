@@ -10,6 +10,7 @@ mod progress;
 mod query;
 mod render;
 mod stability;
+mod stitch;
 mod sweep;
 
 use clap::{Parser, Subcommand};
@@ -40,6 +41,8 @@ enum Command {
     Stability(stability::StabilityArgs),
     /// Compute a distance field on a voxel grid (.npy), exact or smooth.
     Field(field::FieldArgs),
+    /// Assemble the crops written by `render --crop` into the full image.
+    Stitch(stitch::StitchArgs),
 }
 
 /// Parses the command line, runs the command, and maps errors to exit status 2.
@@ -52,6 +55,7 @@ pub fn run() -> ExitCode {
         Command::Sweep(a) => sweep::run(a),
         Command::Stability(a) => stability::run(a),
         Command::Field(a) => field::run(a),
+        Command::Stitch(a) => stitch::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
