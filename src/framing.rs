@@ -39,8 +39,7 @@ pub fn reach_box(objects: &[TraceObject]) -> Option<(DVec3, DVec3)> {
         min = min.min(o.bounds.min.as_dvec3() - r);
         max = max.max(o.bounds.max.as_dvec3() + r);
     }
-    (!objects.is_empty() && min.is_finite() && max.is_finite())
-        .then_some((min, max))
+    (!objects.is_empty() && min.is_finite() && max.is_finite()).then_some((min, max))
 }
 
 /// The camera framing a sphere of `radius` around `centre` for an image of `aspect`
@@ -114,12 +113,17 @@ mod tests {
 
     #[test]
     fn toml_round_trips_through_a_scene_file() {
-        let c = fit_sphere(DVec3::ZERO, 1.0, 1.5, &Framing {
-            direction: DEFAULT_DIRECTION,
-            up: DVec3::Y,
-            fov: 45.0,
-            margin: DEFAULT_MARGIN,
-        });
+        let c = fit_sphere(
+            DVec3::ZERO,
+            1.0,
+            1.5,
+            &Framing {
+                direction: DEFAULT_DIRECTION,
+                up: DVec3::Y,
+                fov: 45.0,
+                margin: DEFAULT_MARGIN,
+            },
+        );
         let text = camera_toml(&c);
         let t: toml::Table = toml::from_str(&text).unwrap();
         let cam = t["camera"].as_table().unwrap();

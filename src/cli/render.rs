@@ -7,11 +7,11 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use smoothtrace::api::params::{Naming, SceneOverrides};
+use smoothtrace::film::aov::AovKind;
+use smoothtrace::film::{AaMode, FilmOptions, Filter, Rect, crop, heatmap, turntable};
 use smoothtrace::output::{IMAGE_8BIT, Kind, Output};
 use smoothtrace::render::TracerOptions;
 use smoothtrace::render::build::BuiltScene;
-use smoothtrace::film::aov::AovKind;
-use smoothtrace::film::{AaMode, FilmOptions, Filter, Rect, crop, heatmap, turntable};
 use smoothtrace::render::image::{ImageStats, Rendered};
 use smoothtrace::render::pipeline;
 use smoothtrace::scene::{AlphaSpec, CameraSettings, Evaluation, Scene};
@@ -197,9 +197,8 @@ fn check_outputs(a: &RenderArgs, film: &FilmOptions) -> Result<Outputs> {
         );
     }
     let image = if turntable {
-        std::fs::create_dir_all(&a.output).with_context(|| {
-            format!("{}: cannot create the frames folder", a.output.display())
-        })?;
+        std::fs::create_dir_all(&a.output)
+            .with_context(|| format!("{}: cannot create the frames folder", a.output.display()))?;
         Output::check(
             &a.output.join(turntable::frame_name(0)),
             &[Kind::Png],
@@ -272,7 +271,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
                 .filter(|&n| (1..=100_000).contains(&n))
                 .with_context(|| format!("--turntable must be in 1..=100000 frames (got {n})"))?;
             let range = match &a.frames {
-                Some(t) => turntable::parse_frames(t, n).map_err(|e| anyhow::anyhow!("--frames: {e}"))?,
+                Some(t) => {
+                    turntable::parse_frames(t, n).map_err(|e| anyhow::anyhow!("--frames: {e}"))?
+                }
                 None => 0..n,
             };
             Some((n, range))
@@ -359,10 +360,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     }
     if let Some(out) = &outputs.gif {
         let delay = (1000 / a.fps) as u32;
-        let images = rendered
-            .iter()
-            .map(|r| r.to_dynamic().to_rgba8())
-            .collect();
+        let images = rendered.iter().map(|r| r.to_dynamic().to_rgba8()).collect();
         let bytes = turntable::encode_gif(images, delay).context("encoding the GIF")?;
         out.write_bytes(&bytes)?;
     }
@@ -493,8 +491,9 @@ fn write_aov(kind: AovKind, out: &Output, r: &Rendered, objects: usize) -> Resul
             out.write_bytes(&bytes)?
         }
         AovKind::Cost => {
-            let img = heatmap::heat_map(&b.costs(), b.width, b.height)
-                .map_err(|e| anyhow::anyhow!("{}: drawing the heat map: {e}", out.path.display()))?;
+            let img = heatmap::heat_map(&b.costs(), b.width, b.height).map_err(|e| {
+                anyhow::anyhow!("{}: drawing the heat map: {e}", out.path.display())
+            })?;
             out.write_image(&image::DynamicImage::ImageRgb8(img))?
         }
     }

@@ -66,9 +66,8 @@ impl AovKind {
                 "expected NAME=PATH with NAME one of {names} (got \"{text}\")"
             ));
         };
-        let kind = AovKind::from_name(name.trim()).ok_or_else(|| {
-            format!("unknown AOV \"{}\" (expected one of {names})", name.trim())
-        })?;
+        let kind = AovKind::from_name(name.trim())
+            .ok_or_else(|| format!("unknown AOV \"{}\" (expected one of {names})", name.trim()))?;
         if path.is_empty() {
             return Err(format!("{name}= needs a file path"));
         }
@@ -228,9 +227,20 @@ mod tests {
         let (k, p) = AovKind::parse_request("normal=out/n.png").unwrap();
         assert_eq!((k, p.to_str().unwrap()), (AovKind::Normal, "out/n.png"));
         let e = AovKind::parse_request("albedo=a.png").unwrap_err();
-        assert!(e.contains("unknown AOV \"albedo\"") && e.contains("cost"), "{e}");
-        assert!(AovKind::parse_request("depth").unwrap_err().contains("NAME=PATH"));
-        assert!(AovKind::parse_request("depth=").unwrap_err().contains("path"));
+        assert!(
+            e.contains("unknown AOV \"albedo\"") && e.contains("cost"),
+            "{e}"
+        );
+        assert!(
+            AovKind::parse_request("depth")
+                .unwrap_err()
+                .contains("NAME=PATH")
+        );
+        assert!(
+            AovKind::parse_request("depth=")
+                .unwrap_err()
+                .contains("path")
+        );
     }
 
     #[test]

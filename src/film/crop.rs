@@ -105,7 +105,10 @@ pub fn encode_crop_png(
         png::ColorType::Rgb
     });
     enc.set_depth(png::BitDepth::Eight);
-    enc.add_text_chunk(CROP_KEY.to_string(), format!("{rect},{},{}", full.0, full.1))?;
+    enc.add_text_chunk(
+        CROP_KEY.to_string(),
+        format!("{rect},{},{}", full.0, full.1),
+    )?;
     let mut w = enc.write_header()?;
     w.write_image_data(pixels)?;
     w.finish()?;
@@ -167,8 +170,11 @@ fn read_piece(path: &Path) -> Result<Piece, StitchError> {
         .map(|s| s.trim().parse())
         .collect::<Result<_, _>>()
         .map_err(|_| fail(format!("bad `{CROP_KEY}` value \"{place}\"")))?;
-    let [x0, y0, x1, y1, w, h] = <[u32; 6]>::try_from(nums)
-        .map_err(|_| fail(format!("bad `{CROP_KEY}` value \"{place}\" (expected 6 numbers)")))?;
+    let [x0, y0, x1, y1, w, h] = <[u32; 6]>::try_from(nums).map_err(|_| {
+        fail(format!(
+            "bad `{CROP_KEY}` value \"{place}\" (expected 6 numbers)"
+        ))
+    })?;
     let rect = Rect { x0, y0, x1, y1 };
     if x0 >= x1 || y0 >= y1 || x1 > w || y1 > h {
         return Err(fail(format!(

@@ -48,8 +48,12 @@ pub fn heat_map(costs: &[u32], width: u32, height: u32) -> Result<image::RgbImag
         let (bar_x0, bar_x1) = (width as i32 + 8, width as i32 + 26);
         let (bar_y0, bar_y1) = (22i32, height as i32 - 10);
         let text = ("sans-serif", 12).into_font().color(&BLACK);
-        root.draw(&Text::new("evals/pixel", (width as i32 + 4, 4), text.clone()))
-            .map_err(err)?;
+        root.draw(&Text::new(
+            "evals/pixel",
+            (width as i32 + 4, 4),
+            text.clone(),
+        ))
+        .map_err(err)?;
         if bar_y1 > bar_y0 + 4 {
             let span = f64::from(bar_y1 - bar_y0);
             for y in bar_y0..=bar_y1 {
@@ -94,7 +98,9 @@ mod tests {
     #[test]
     fn heat_map_colours_pixels_by_cost_and_draws_a_bar() {
         let (w, h) = (64, 80);
-        let costs: Vec<u32> = (0..w * h).map(|i| if i % w < 32 { 0 } else { 50 }).collect();
+        let costs: Vec<u32> = (0..w * h)
+            .map(|i| if i % w < 32 { 0 } else { 50 })
+            .collect();
         let img = heat_map(&costs, w, h).unwrap();
         assert_eq!(img.dimensions(), (w + PANEL, h));
         let map = Colormap::Inferno;

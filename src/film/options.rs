@@ -72,7 +72,6 @@ pub const MAX_SAMPLES: u32 = 1024;
 
 /// The message for a sample count out of range, if it is (`what` names the flag or key).
 pub fn samples_error(what: &str, samples: i64) -> Option<String> {
-    (!(1..=i64::from(MAX_SAMPLES)).contains(&samples)).then(|| {
-        format!("{what} must be in 1..={MAX_SAMPLES} samples per pixel (got {samples})")
-    })
+    (!(1..=i64::from(MAX_SAMPLES)).contains(&samples))
+        .then(|| format!("{what} must be in 1..={MAX_SAMPLES} samples per pixel (got {samples})"))
 }

@@ -91,7 +91,9 @@ mod tests {
             for cy in 0..3 {
                 let inside = p
                     .iter()
-                    .filter(|s| (s.offset[0] * 3.0) as i32 == cx && (s.offset[1] * 3.0) as i32 == cy)
+                    .filter(|s| {
+                        (s.offset[0] * 3.0) as i32 == cx && (s.offset[1] * 3.0) as i32 == cy
+                    })
                     .count();
                 assert_eq!(inside, 1, "cell {cx},{cy}");
             }
@@ -106,7 +108,10 @@ mod tests {
             // The closest pair is not much closer than a grid of n points would have.
             let mut closest = f64::INFINITY;
             for (i, a) in p.iter().enumerate() {
-                assert!(a.offset.iter().all(|&c| (0.0..1.0).contains(&c)), "{n}: {a:?}");
+                assert!(
+                    a.offset.iter().all(|&c| (0.0..1.0).contains(&c)),
+                    "{n}: {a:?}"
+                );
                 assert!(a.weight > 0.0 && a.weight <= 1.0);
                 for b in &p[i + 1..] {
                     let d = ((a.offset[0] - b.offset[0]).powi(2)
@@ -115,7 +120,10 @@ mod tests {
                     closest = closest.min(d);
                 }
             }
-            assert!(closest > 0.4 / (n as f64).sqrt(), "{n}: closest pair {closest}");
+            assert!(
+                closest > 0.4 / (n as f64).sqrt(),
+                "{n}: closest pair {closest}"
+            );
         }
     }
 

@@ -94,7 +94,10 @@ mod tests {
         }
         let quarter = orbit_camera(&base, 2, 8).unwrap().origin() - base.target();
         // A quarter turn about +y takes +z to +x (and +x to -z).
-        assert!((quarter - DVec3::new(4.0, 1.0, -2.0)).length() < 1e-12, "{quarter}");
+        assert!(
+            (quarter - DVec3::new(4.0, 1.0, -2.0)).length() < 1e-12,
+            "{quarter}"
+        );
         assert_eq!(orbit_camera(&base, 0, 8).unwrap().origin(), base.origin());
     }
 

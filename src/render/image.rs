@@ -181,7 +181,6 @@ impl ImageStats {
     }
 }
 
-
 /// A rendered image (or crop) with its per-pixel hit distances and AOV records.
 pub struct Rendered {
     /// The colours: composited over the background for an opaque render; the hits' own
@@ -503,9 +502,9 @@ impl NeighbourView {
     }
 
     fn index(&self, x: u32, y: u32) -> Option<usize> {
-        self.rect.contains(x, y).then(|| {
-            ((y - self.rect.y0) * self.rect.width() + (x - self.rect.x0)) as usize
-        })
+        self.rect
+            .contains(x, y)
+            .then(|| ((y - self.rect.y0) * self.rect.width() + (x - self.rect.x0)) as usize)
     }
 
     fn put(&mut self, x: u32, y: u32, colour: Option<[u8; 3]>, record: &PixelRecord) {
@@ -562,9 +561,9 @@ impl RegionFilm {
     }
 
     fn index(&self, x: u32, y: u32) -> Option<usize> {
-        self.rect.contains(x, y).then(|| {
-            ((y - self.rect.y0) * self.rect.width() + (x - self.rect.x0)) as usize
-        })
+        self.rect
+            .contains(x, y)
+            .then(|| ((y - self.rect.y0) * self.rect.width() + (x - self.rect.x0)) as usize)
     }
 
     /// Keeps a traced pixel if it is in the region.
@@ -603,7 +602,7 @@ impl RegionFilm {
             image,
             alpha,
             depth,
-            aovs: options.keep_aovs.then(|| AovBuffers {
+            aovs: options.keep_aovs.then_some(AovBuffers {
                 width: w,
                 height: h,
                 records: self.records,

@@ -125,9 +125,11 @@ impl Resolver<'_> {
                         .to_string(),
                 ));
             }
-            let direction = raw.direction.map_or(crate::framing::DEFAULT_DIRECTION, |v| {
-                self.vec3("camera.direction", &v)
-            });
+            let direction = raw
+                .direction
+                .map_or(crate::framing::DEFAULT_DIRECTION, |v| {
+                    self.vec3("camera.direction", &v)
+                });
             let framing = Framing {
                 direction,
                 up,
@@ -151,7 +153,11 @@ impl Resolver<'_> {
             ));
         }
         let (Some(origin), Some(target)) = (&raw.origin, &raw.target) else {
-            let given = raw.origin.as_ref().or(raw.target.as_ref()).expect("one is given");
+            let given = raw
+                .origin
+                .as_ref()
+                .or(raw.target.as_ref())
+                .expect("one is given");
             return Err(self.invalid(
                 given.span(),
                 "camera",

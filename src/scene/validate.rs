@@ -204,7 +204,9 @@ impl Checker<'_> {
         if let Some(message) = max_steps_error(i64::from(r.max_steps)) {
             return Err(self.fail("render.max_steps", &r.max_steps, message));
         }
-        if let Some(message) = crate::film::options::samples_error("render.samples", r.samples.into()) {
+        if let Some(message) =
+            crate::film::options::samples_error("render.samples", r.samples.into())
+        {
             return Err(self.fail("render.samples", &r.samples, message));
         }
         Ok(())
