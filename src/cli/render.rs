@@ -376,8 +376,22 @@ pub fn run(a: RenderArgs) -> Result<()> {
         )),
         None => a.output.clone(),
     };
-    for st in &stats {
-        note!("{}", summary(&a.scene, st, &shown));
+    match stats.as_slice() {
+        [st] => note!("{}", summary(&a.scene, st, &shown)),
+        all => {
+            let seconds: f64 = all.iter().map(|s| s.seconds).sum();
+            let rays: u64 = all.iter().map(|s| s.rays).sum();
+            note!(
+                "{}: {} frames of {}x{} in {seconds:.3} s ({:.3} s per frame, {:.0} rays/s) -> {}",
+                a.scene.display(),
+                all.len(),
+                all[0].width,
+                all[0].height,
+                seconds / all.len() as f64,
+                rays as f64 / seconds.max(1e-12),
+                shown.display()
+            )
+        }
     }
     let exhausted: u64 = stats.iter().map(|s| s.exhausted).sum();
     if exhausted > 0 {

@@ -10,18 +10,20 @@
 //! - Adaptive: a pass at the pixel centres; then the pixels whose centre sample
 //!   disagrees with a 4-neighbour's (hit or miss, object, normals more than
 //!   [`NORMAL_ANGLE_DEG`] apart, a channel more than [`SHADE_DIFF`] levels apart) get the
-//!   full pattern instead, traced ray by ray from the camera's clearance. Their centre
+//!   full pattern instead, traced ray by ray after a cone march of the pixel's own
+//!   rays ([`Context::pixel_start`]). Their centre
 //!   sample is dropped from the colour (the pixel is then exactly the uniform pixel) but
 //!   still gives its AOV record.
 
 use super::cone::{ConeStats, Tile, trace_tile};
-use super::tracer::{Hit, RayResult, Tracer};
+use super::tracer::{Hit, RayResult, RayStats, Tracer};
 use crate::camera::Camera;
 use crate::film::accumulate::PixelAccum;
 use crate::film::aov::{AovBuffers, PixelRecord};
 use crate::film::pattern::{Sample, pattern, primary};
 use crate::film::{AaMode, FilmOptions, Rect};
 use crate::matcap::MatCap;
+use glam::DVec3;
 use image::{GrayImage, RgbImage};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -31,11 +33,11 @@ pub const TILE: u32 = 16;
 
 /// Adaptive sampling: neighbours whose normals are further apart than this (degrees)
 /// disagree.
-pub const NORMAL_ANGLE_DEG: f64 = 20.0;
+pub const NORMAL_ANGLE_DEG: f64 = 30.0;
 
 /// Adaptive sampling: neighbours whose colours differ by more than this in a channel
 /// (of 255) disagree.
-pub const SHADE_DIFF: u8 = 24;
+pub const SHADE_DIFF: u8 = 32;
 
 /// Per-image statistics (SPEC 7).
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
@@ -464,23 +466,76 @@ impl Context<'_> {
         }
     }
 
-    /// Traces pixel `(x, y)` at each position of `samples`, ray by ray: its colour, the
-    /// evaluations it took and the work.
+    /// Traces pixel `(x, y)` at each position of `samples`, ray by ray from the pixel's
+    /// own cone march ([`Context::pixel_start`]): its colour, the evaluations it took
+    /// and the work.
     fn trace_pixel(&self, x: u32, y: u32, samples: &[Sample]) -> (PixelAccum, u32, ImageStats) {
         let mut acc = PixelAccum::default();
         let mut stats = ImageStats::default();
         let mut cost = 0;
-        for s in samples {
-            let (o, d) = self
-                .camera
-                .ray_through(f64::from(x) + s.offset[0], f64::from(y) + s.offset[1]);
-            let r: RayResult = self.tracer.trace(o, d, self.s0);
+        let rays: Vec<(DVec3, DVec3)> = samples
+            .iter()
+            .map(|s| {
+                self.camera
+                    .ray_through(f64::from(x) + s.offset[0], f64::from(y) + s.offset[1])
+            })
+            .collect();
+        let start = self.pixel_start(x, y, &rays, &mut stats);
+        for (s, &(o, d)) in samples.iter().zip(&rays) {
+            let r = match start {
+                Some(t) => self.tracer.trace(o, d, t),
+                None => RayResult::default(),
+            };
             stats.tally(&r);
             cost += r.stats.evals + r.stats.coarse_evals;
             let colour = r.hit.map(|hit| self.shade(&hit, &mut stats));
             acc.add(colour, s.weight);
         }
         (acc, cost, stats)
+    }
+
+    /// Where the sample rays of pixel `(x, y)` can start: a cone march around the pixel
+    /// centre's ray, the argument of `render::cone` (SPEC 7) for one pixel's rays. At
+    /// parameter `t` every ray is within `spread * t` of the axis point, so a bound `r`
+    /// there lets all of them advance by `r - spread * t`; the march stops when that is
+    /// less than half of `r`. `None`: past the scene box, every ray misses. Without cone
+    /// marching (or bound steps) the rays start at the camera's clearance, as every
+    /// other ray does then.
+    fn pixel_start(
+        &self,
+        x: u32,
+        y: u32,
+        rays: &[(DVec3, DVec3)],
+        stats: &mut ImageStats,
+    ) -> Option<f64> {
+        let opts = self.tracer.options();
+        if !opts.cone || opts.coarse_beta <= 0.0 {
+            return Some(self.s0);
+        }
+        let (o, axis) = self
+            .camera
+            .ray_through(f64::from(x) + 0.5, f64::from(y) + 0.5);
+        let spread = rays
+            .iter()
+            .map(|&(_, d)| (d - axis).length())
+            .fold(0.0, f64::max);
+        let t_far = self.tracer.farthest(o);
+        let mut t = self.s0;
+        let mut cones = ConeStats::default();
+        while t <= t_far {
+            let mut ray = RayStats::default();
+            let r = self.tracer.bound(o + t * axis, opts.coarse_beta, &mut ray);
+            cones.evals += ray.coarse_evals as u64;
+            cones.leaves += ray.eval.leaves() as u64;
+            cones.nodes += ray.eval.nodes as u64;
+            let step = r - spread * t;
+            if step.is_nan() || step <= 0.5 * r {
+                break;
+            }
+            t += step;
+        }
+        stats.add_cones(&cones);
+        (t <= t_far).then_some(t)
     }
 }
 
