@@ -76,9 +76,10 @@ pub fn fit_objects(objects: &[TraceObject], aspect: f64, f: &Framing) -> Option<
 
 /// The camera as TOML that can be pasted into a scene file.
 pub fn camera_toml(c: &CameraSettings) -> String {
-    let v = |v: DVec3| format!("[{}, {}, {}]", v.x, v.y, v.z);
+    // `{:?}` prints the shortest decimal that reads back as the same f64, with a point.
+    let v = |v: DVec3| format!("[{:?}, {:?}, {:?}]", v.x, v.y, v.z);
     format!(
-        "[camera]\norigin = {}\ntarget = {}\nup = {}\nfov = {}",
+        "[camera]\norigin = {}\ntarget = {}\nup = {}\nfov = {:?}",
         v(c.origin),
         v(c.target),
         v(c.up),

@@ -41,6 +41,17 @@ impl Rect {
         (self.x0..self.x1).contains(&x) && (self.y0..self.y1).contains(&y)
     }
 
+    /// Pixels in it.
+    pub fn area(&self) -> usize {
+        self.width() as usize * self.height() as usize
+    }
+
+    /// The row-major index of pixel `(x, y)` (full-image coordinates) within it.
+    pub fn index(&self, x: u32, y: u32) -> Option<usize> {
+        self.contains(x, y)
+            .then(|| ((y - self.y0) * self.width() + (x - self.x0)) as usize)
+    }
+
     /// Grown by `by` pixels on every side, within a `width x height` image.
     pub fn grown(&self, by: u32, width: u32, height: u32) -> Rect {
         Rect {
@@ -314,5 +325,10 @@ mod tests {
         assert!(r.overlaps(&Rect::parse("7,7,9,9", 10, 10).unwrap()));
         assert!(!r.overlaps(&Rect::parse("8,0,9,9", 10, 10).unwrap()));
         assert!(r.contains(7, 7) && !r.contains(8, 7) && !r.contains(0, 3));
+        assert_eq!(
+            (r.area(), r.index(0, 4), r.index(7, 7)),
+            (32, Some(0), Some(31))
+        );
+        assert_eq!(r.index(8, 4), None);
     }
 }

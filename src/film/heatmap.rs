@@ -107,8 +107,9 @@ mod tests {
         assert_eq!(img.get_pixel(0, 0).0, map.srgb8(0.0));
         assert_eq!(img.get_pixel(40, 10).0, map.srgb8(1.0));
         // The bar: top colour near its top, bottom colour near its bottom.
-        assert_eq!(img.get_pixel(w + 16, 24).0, map.srgb8(1.0 - 2.0 / 58.0));
-        assert_eq!(img.get_pixel(w + 16, h - 11).0, map.srgb8(0.0));
+        // The bar runs from y 22 (top of the scale) to y h - 10 = 70 (zero).
+        assert_eq!(img.get_pixel(w + 16, 24).0, map.srgb8(46.0 / 48.0));
+        assert_eq!(img.get_pixel(w + 16, h - 11).0, map.srgb8(1.0 / 48.0));
         // Some label text (dark pixels) right of the bar.
         let dark = (w + 28..w + PANEL)
             .flat_map(|x| (0..h).map(move |y| (x, y)))

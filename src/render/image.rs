@@ -261,7 +261,7 @@ pub fn render_film(
     let (w, h) = (camera.width(), camera.height());
     let start = Instant::now();
     let region = options.crop.unwrap_or(Rect::full(w, h));
-    let n = region.width() as usize * region.height() as usize;
+    let n = region.area();
     let mut stats = ImageStats {
         width: w,
         height: h,
@@ -548,7 +548,7 @@ struct NeighbourView {
 
 impl NeighbourView {
     fn new(rect: Rect) -> NeighbourView {
-        let n = rect.width() as usize * rect.height() as usize;
+        let n = rect.area();
         NeighbourView {
             rect,
             colour: vec![None; n],
@@ -556,14 +556,8 @@ impl NeighbourView {
         }
     }
 
-    fn index(&self, x: u32, y: u32) -> Option<usize> {
-        self.rect
-            .contains(x, y)
-            .then(|| ((y - self.rect.y0) * self.rect.width() + (x - self.rect.x0)) as usize)
-    }
-
     fn put(&mut self, x: u32, y: u32, colour: Option<[u8; 3]>, record: &PixelRecord) {
-        if let Some(i) = self.index(x, y) {
+        if let Some(i) = self.rect.index(x, y) {
             self.colour[i] = colour;
             self.records[i] = *record;
         }
@@ -571,7 +565,7 @@ impl NeighbourView {
 
     /// Whether pixel `(x, y)`'s centre sample disagrees with a 4-neighbour's.
     fn disagrees(&self, x: u32, y: u32) -> bool {
-        let Some(i) = self.index(x, y) else {
+        let Some(i) = self.rect.index(x, y) else {
             return false;
         };
         let neighbours = [
@@ -582,7 +576,7 @@ impl NeighbourView {
         ];
         let cos_max = NORMAL_ANGLE_DEG.to_radians().cos() as f32;
         neighbours.into_iter().any(|(nx, ny)| {
-            let Some(j) = self.index(nx, ny) else {
+            let Some(j) = self.rect.index(nx, ny) else {
                 return false;
             };
             let (a, b) = (&self.records[i], &self.records[j]);
@@ -607,7 +601,7 @@ struct RegionFilm {
 
 impl RegionFilm {
     fn new(rect: Rect) -> RegionFilm {
-        let n = rect.width() as usize * rect.height() as usize;
+        let n = rect.area();
         RegionFilm {
             rect,
             accum: vec![PixelAccum::default(); n],
@@ -615,15 +609,9 @@ impl RegionFilm {
         }
     }
 
-    fn index(&self, x: u32, y: u32) -> Option<usize> {
-        self.rect
-            .contains(x, y)
-            .then(|| ((y - self.rect.y0) * self.rect.width() + (x - self.rect.x0)) as usize)
-    }
-
     /// Keeps a traced pixel if it is in the region.
     fn put(&mut self, x: u32, y: u32, accum: PixelAccum, record: PixelRecord) {
-        if let Some(i) = self.index(x, y) {
+        if let Some(i) = self.rect.index(x, y) {
             self.accum[i] = accum;
             self.records[i] = record;
         }
@@ -631,7 +619,7 @@ impl RegionFilm {
 
     /// Replaces a pixel's colour samples, adding the new rays' cost.
     fn replace_colour(&mut self, x: u32, y: u32, accum: PixelAccum, cost: u32) {
-        if let Some(i) = self.index(x, y) {
+        if let Some(i) = self.rect.index(x, y) {
             self.accum[i] = accum;
             self.records[i].cost += cost;
         }
