@@ -15,6 +15,8 @@ pub mod camera;
 pub mod colour;
 pub mod eval;
 pub mod field;
+pub mod film;
+pub mod framing;
 pub mod geometry;
 pub mod las;
 pub mod limits;

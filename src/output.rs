@@ -1,7 +1,7 @@
 //! Output files that are checked before the long work and never left half-written.
 //!
 //! [`Output::check`] runs before a render, a field or a report starts: the extension
-//! must name a format the caller can write (so `render -o x.gif` fails at once, not
+//! must name a format the caller can write (so `render -o x.tif` fails at once, not
 //! after the whole image), the path must not be a directory, and its folder must exist
 //! and accept a new file (a temporary file is created and removed to prove it).
 //! [`Output::check_as`] is the same for outputs whose format a flag decides (`--csv`,
@@ -30,6 +30,8 @@ pub enum Kind {
     Csv,
     Json,
     Npy,
+    /// Animated GIF (turntables), encoded by the caller and written with `write_bytes`.
+    Gif,
 }
 
 /// The 8-bit image formats (render images, previews, plots).
@@ -47,6 +49,7 @@ impl Kind {
             "csv" => Kind::Csv,
             "json" => Kind::Json,
             "npy" => Kind::Npy,
+            "gif" => Kind::Gif,
             _ => return None,
         })
     }
@@ -61,6 +64,7 @@ impl Kind {
             Kind::Csv => ".csv",
             Kind::Json => ".json",
             Kind::Npy => ".npy",
+            Kind::Gif => ".gif",
         }
     }
 
@@ -251,7 +255,8 @@ mod tests {
     fn formats_by_extension() {
         assert_eq!(Kind::from_path(Path::new("a/b.JPG")), Some(Kind::Jpeg));
         assert_eq!(Kind::from_path(Path::new("b.webp")), Some(Kind::WebP));
-        assert_eq!(Kind::from_path(Path::new("b.gif")), None);
+        assert_eq!(Kind::from_path(Path::new("b.gif")), Some(Kind::Gif));
+        assert_eq!(Kind::from_path(Path::new("b.tif")), None);
         assert_eq!(Kind::from_path(Path::new("b")), None);
     }
 

@@ -20,12 +20,19 @@ fn root() -> PathBuf {
 }
 
 fn render_small(scene: &str, threads: usize) -> image::RgbImage {
+    render_with(scene, threads, |_| {}).to_rgb8()
+}
+
+/// A small render of `scene` after `adjust` changed its settings (samples, background):
+/// RGB, or RGBA for a transparent render.
+fn render_with(scene: &str, threads: usize, adjust: impl Fn(&mut Scene)) -> image::DynamicImage {
     let mut s = Scene::load(&root().join("scenes").join(scene)).unwrap();
     s.image.width = WIDTH;
     s.image.height = HEIGHT;
     s.render.threads = threads;
+    adjust(&mut s);
     s.validate().unwrap();
-    render_scene(&s, |o| o, &|_| {}).unwrap().1.image
+    render_scene(&s, |o| o, &|_| {}).unwrap().1.to_dynamic()
 }
 
 struct Diff {
@@ -35,14 +42,24 @@ struct Diff {
     image: image::RgbImage,
 }
 
+/// Compares RGB(A) images channel by channel (alpha too: 255 for RGB images).
 fn diff(a: &image::RgbImage, b: &image::RgbImage) -> Diff {
+    diff_rgba(
+        &image::DynamicImage::ImageRgb8(a.clone()).to_rgba8(),
+        &image::DynamicImage::ImageRgb8(b.clone()).to_rgba8(),
+        3,
+    )
+}
+
+/// Compares the first `channels` channels (3: colour only, 4: with alpha).
+fn diff_rgba(a: &image::RgbaImage, b: &image::RgbaImage, channels: usize) -> Diff {
     assert_eq!(a.dimensions(), b.dimensions());
     let mut image = image::RgbImage::new(a.width(), a.height());
     let (mut differing, mut sum, mut max) = (0usize, 0u64, 0u8);
     for (x, y, pa) in a.enumerate_pixels() {
         let pb = b.get_pixel(x, y);
-        let d: [u8; 3] = std::array::from_fn(|k| pa[k].abs_diff(pb[k]));
-        let m = d.into_iter().max().unwrap();
+        let d: Vec<u8> = (0..channels).map(|k| pa[k].abs_diff(pb[k])).collect();
+        let m = d.iter().copied().max().unwrap();
         differing += (m > CHANNEL_THRESHOLD) as usize;
         sum += d.iter().map(|&v| v as u64).sum::<u64>();
         max = max.max(m);
@@ -51,7 +68,7 @@ fn diff(a: &image::RgbImage, b: &image::RgbImage) -> Diff {
     let n = (a.width() * a.height()) as f64;
     Diff {
         differing_share: differing as f64 / n,
-        mean: sum as f64 / (3.0 * n),
+        mean: sum as f64 / (channels as f64 * n),
         max,
         image,
     }
@@ -63,17 +80,22 @@ fn check(scene: &str) {
         .unwrap()
         .to_string_lossy()
         .into_owned();
+    check_image(scene, &name, render_with(scene, 2, |_| {}));
+}
+
+/// Compares `got` (a render of `scene`) with the golden `tests/golden/{name}.png`.
+fn check_image(scene: &str, name: &str, got: image::DynamicImage) {
     let golden = root().join("tests/golden").join(format!("{name}.png"));
-    let got = render_small(scene, 2);
     if std::env::var_os("SMOOTHTRACE_BLESS").is_some() {
         got.save(&golden).unwrap();
         println!("blessed {}", golden.display());
         return;
     }
     let want = image::open(&golden)
-        .unwrap_or_else(|e| panic!("{}: {e} (bless with SMOOTHTRACE_BLESS=1)", golden.display()))
-        .to_rgb8();
-    let d = diff(&got, &want);
+        .unwrap_or_else(|e| panic!("{}: {e} (bless with SMOOTHTRACE_BLESS=1)", golden.display()));
+    assert_eq!(got.color(), want.color(), "{name}: RGB against RGBA");
+    let channels = if got.color().has_alpha() { 4 } else { 3 };
+    let d = diff_rgba(&got.to_rgba8(), &want.to_rgba8(), channels);
     if d.differing_share > MAX_DIFFERING_SHARE || d.mean > MAX_MEAN_DIFF {
         let out = root().join("target/golden-diff");
         std::fs::create_dir_all(&out).unwrap();
@@ -135,6 +157,46 @@ fn golden_bucky_ball() {
 #[test]
 fn golden_colour_vertex() {
     check("colour_vertex.toml");
+}
+
+// Issue 11: the film. Each golden changes one setting of a scene above.
+
+#[test]
+fn golden_uniform_4x_anti_aliasing() {
+    let img = render_with("bucky_ball.toml", 2, |s| s.render.samples = 4);
+    check_image("bucky_ball.toml, 4 samples", "bucky_ball_aa4", img);
+}
+
+#[test]
+fn golden_adaptive_anti_aliasing() {
+    let img = render_with("showcase.toml", 2, |s| {
+        s.render.samples = 9;
+        s.render.aa = smoothtrace::film::AaMode::Adaptive;
+    });
+    check_image(
+        "showcase.toml, 9 samples adaptive",
+        "showcase_adaptive9",
+        img,
+    );
+}
+
+#[test]
+fn golden_transparent_background() {
+    let img = render_with("spiky_sphere.toml", 2, |s| {
+        s.render.samples = 4;
+        s.image.transparent = true;
+    });
+    assert!(matches!(img, image::DynamicImage::ImageRgba8(_)));
+    check_image(
+        "spiky_sphere.toml, transparent",
+        "spiky_sphere_transparent",
+        img,
+    );
+}
+
+#[test]
+fn golden_auto_framed_scene() {
+    check("auto_framed.toml");
 }
 
 #[test]

@@ -647,12 +647,22 @@ fn degenerate_camera() {
     }
     let msg = error(&minimal().replace("[0.0, 1.0, 5.0]", "[0.0, inf, 5.0]"));
     assert_mentions(&msg, &[":2:10:", "camera.origin must be finite"]);
+    // Without origin and target the camera is auto-framed (issue 11); half of them is
+    // an error that says what to add.
     let msg = error("[camera]\ntarget = [0, 0, 0]\n");
-    assert_mentions(&msg, &[":1:1:", "missing field `origin` in [camera]"]);
+    assert_mentions(
+        &msg,
+        &[
+            ":2:10:",
+            "[camera] needs both origin and target, or fit = true",
+        ],
+    );
+    let msg = error(&minimal().replace("[camera]\n", "[camera]\nfit = true\n"));
+    assert_mentions(&msg, &["camera.fit = true places the camera itself"]);
+    let msg = error(&minimal().replace("[camera]\n", "[camera]\ndirection = [1, 0, 0]\n"));
+    assert_mentions(&msg, &[":2:13:", "camera.direction", "add fit = true"]);
     let msg = error("[image]\nwidth = 10\n");
-    assert_mentions(&msg, &["scenes/x.toml:1:1:", "missing [camera] table"]);
-    let msg = error("");
-    assert_mentions(&msg, &["scenes/x.toml:1:1:", "missing [camera] table"]);
+    assert_mentions(&msg, &["scenes/x.toml:", "no [[object]] in scene"]);
 }
 
 #[test]

@@ -24,11 +24,8 @@ type CameraArgs = ([f64; 3], [f64; 3], [f64; 3], f64);
 
 fn rgba<'py>(py: Python<'py>, r: &Rendered) -> PyResult<Image<'py>> {
     let (w, h) = (r.image.width() as usize, r.image.height() as usize);
-    let values = r
-        .image
-        .pixels()
-        .flat_map(|p| [p[0], p[1], p[2], 255])
-        .collect();
+    // Straight alpha from a transparent scene, 255 otherwise.
+    let values = r.to_dynamic().to_rgba8().into_raw();
     output::<_, Ix3>(py, (h, w, 4), values)
 }
 

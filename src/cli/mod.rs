@@ -11,6 +11,7 @@ mod query;
 mod render;
 mod serve;
 mod stability;
+mod stitch;
 mod sweep;
 
 use clap::{Parser, Subcommand};
@@ -43,6 +44,8 @@ enum Command {
     Field(field::FieldArgs),
     /// Build a scene in the browser: a local web page with a live, progressive view.
     Serve(serve::ServeArgs),
+    /// Assemble the crops written by `render --crop` into the full image.
+    Stitch(stitch::StitchArgs),
 }
 
 /// Parses the command line, runs the command, and maps errors to exit status 2.
@@ -56,6 +59,7 @@ pub fn run() -> ExitCode {
         Command::Stability(a) => stability::run(a),
         Command::Field(a) => field::run(a),
         Command::Serve(a) => serve::run(a),
+        Command::Stitch(a) => stitch::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

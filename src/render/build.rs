@@ -240,10 +240,20 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
         shaders.push(shader);
     }
     let bounds = objects.iter().fold(Aabb::EMPTY, |b, o| b.union(o.bounds));
-    let camera = scene.camera().map_err(|source| BuildError::Camera {
-        scene: name.clone(),
-        source,
-    })?;
+    // Auto-framing needs the objects' reach, known only now.
+    let settings = match &scene.framing {
+        Some(f) => {
+            let aspect = f64::from(scene.image.width) / f64::from(scene.image.height);
+            crate::framing::fit_objects(&objects, aspect, f).unwrap_or(scene.camera)
+        }
+        None => scene.camera,
+    };
+    let camera = settings
+        .build(scene.image.width, scene.image.height)
+        .map_err(|source| BuildError::Camera {
+            scene: name.clone(),
+            source,
+        })?;
     Ok(BuiltScene {
         objects,
         shaders,

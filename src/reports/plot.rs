@@ -9,7 +9,8 @@ use std::sync::Once;
 
 static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
-fn register() {
+/// Registers the embedded font as "sans-serif" (once); needed before any text is drawn.
+pub(crate) fn register() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // The font is compiled in: it cannot fail to parse unless the asset is broken,

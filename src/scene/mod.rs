@@ -27,6 +27,8 @@ pub use error::{Location, SceneError};
 pub use transform::Transform;
 
 use crate::camera::{Camera, CameraError};
+use crate::film::{AaMode, FilmOptions, Filter};
+pub use crate::framing::Framing;
 pub use crate::las::LasOptions;
 use crate::primitives::PrimitiveKind;
 use crate::procedural::Generator;
@@ -44,6 +46,9 @@ pub struct Scene {
     /// The scene file (named in error messages); empty for a scene built in code.
     pub path: PathBuf,
     pub camera: CameraSettings,
+    /// `Some`: the camera is placed by auto-framing when the scene is built (no
+    /// `[camera]`, or `fit = true`); `camera.up` and `camera.fov` still apply.
+    pub framing: Option<Framing>,
     pub image: ImageSettings,
     pub render: RenderSettings,
     pub objects: Vec<Object>,
@@ -71,6 +76,8 @@ pub struct ImageSettings {
     pub height: u32,
     /// RGB colour of rays that miss; default white.
     pub background: [u8; 3],
+    /// `background = "transparent"`: RGBA output, alpha 0 where rays miss.
+    pub transparent: bool,
 }
 
 /// `[render]`.
@@ -85,6 +92,12 @@ pub struct RenderSettings {
     pub evaluation: Evaluation,
     /// Worker threads; 0 = all cores (default).
     pub threads: usize,
+    /// Samples per pixel, in `1..=film::options::MAX_SAMPLES`; default 1.
+    pub samples: u32,
+    /// `"uniform"` (default) or `"adaptive"`.
+    pub aa: AaMode,
+    /// `"box"` (default) or `"gaussian"`.
+    pub filter: Filter,
 }
 
 /// The sphere-tracing hit threshold.
@@ -205,6 +218,7 @@ impl Default for ImageSettings {
             width: 960,
             height: 540,
             background: [255, 255, 255],
+            transparent: false,
         }
     }
 }
@@ -217,6 +231,9 @@ impl Default for RenderSettings {
             max_steps: 1000,
             evaluation: Evaluation::Stable,
             threads: 0,
+            samples: 1,
+            aa: AaMode::Uniform,
+            filter: Filter::Box,
         }
     }
 }
@@ -281,6 +298,7 @@ impl Scene {
         Scene {
             path: PathBuf::new(),
             camera,
+            framing: None,
             image: ImageSettings::default(),
             render: RenderSettings::default(),
             objects,
@@ -295,7 +313,21 @@ impl Scene {
         validate::validate(self)
     }
 
-    /// The camera for this scene's image size.
+    /// The film settings of the scene's `[image]` and `[render]` (whole image, no AOVs).
+    pub fn film_options(&self) -> FilmOptions {
+        FilmOptions {
+            samples: self.render.samples,
+            aa: self.render.aa,
+            filter: self.render.filter,
+            background: self.image.background,
+            transparent: self.image.transparent,
+            crop: None,
+            keep_aovs: false,
+        }
+    }
+
+    /// The camera for this scene's image size (as written: for a scene with
+    /// [`Scene::framing`] the camera comes from `render::build`, which sees the objects).
     pub fn camera(&self) -> Result<Camera, CameraError> {
         self.camera.build(self.image.width, self.image.height)
     }

@@ -9,7 +9,8 @@ use toml::Spanned;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawScene {
-    pub camera: RawCamera,
+    /// Absent: the camera frames the scene (`crate::framing`).
+    pub camera: Option<RawCamera>,
     #[serde(default)]
     pub image: RawImage,
     #[serde(default)]
@@ -21,10 +22,13 @@ pub(super) struct RawScene {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawCamera {
-    pub origin: Spanned<[f64; 3]>,
-    pub target: Spanned<[f64; 3]>,
+    pub origin: Option<Spanned<[f64; 3]>>,
+    pub target: Option<Spanned<[f64; 3]>>,
     pub up: Option<Spanned<[f64; 3]>>,
     pub fov: Option<Spanned<f64>>,
+    // Auto-framing (issue 11): `fit = true` with an optional view direction.
+    pub fit: Option<Spanned<bool>>,
+    pub direction: Option<Spanned<[f64; 3]>>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -45,6 +49,10 @@ pub(super) struct RawRender {
     pub max_steps: Option<Spanned<i64>>,
     pub evaluation: Option<Evaluation>,
     pub threads: Option<Spanned<i64>>,
+    // Anti-aliasing (issue 11): checked when resolving.
+    pub samples: Option<Spanned<i64>>,
+    pub aa: Option<Spanned<String>>,
+    pub filter: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -11,6 +11,9 @@ use super::{
     Scene, Transform,
 };
 use crate::camera::Camera;
+use crate::film::options::samples_error;
+use crate::film::{AaMode, Filter};
+use crate::framing::Framing;
 use crate::matcap::MatCapSpec;
 use crate::primitives::PrimitiveKind;
 use glam::DVec3;
@@ -30,7 +33,7 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
         dir: path.parent().unwrap_or(Path::new("")).to_path_buf(),
         origins: Origins::default(),
     };
-    let camera = r.camera(raw.camera);
+    let (camera, framing) = r.camera(raw.camera)?;
     let image = r.image(raw.image)?;
     let render = r.render(raw.render)?;
     let objects = raw
@@ -42,6 +45,7 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
     Ok(Scene {
         path: path.to_path_buf(),
         camera,
+        framing,
         image,
         render,
         objects,
@@ -88,15 +92,86 @@ impl Resolver<'_> {
         value
     }
 
-    fn camera(&mut self, raw: RawCamera) -> CameraSettings {
-        CameraSettings {
-            origin: self.vec3("camera.origin", &raw.origin),
-            target: self.vec3("camera.target", &raw.target),
-            up: raw.up.map_or(DVec3::Y, |v| self.vec3("camera.up", &v)),
-            fov: raw
-                .fov
-                .map_or(Camera::DEFAULT_FOV_Y, |v| self.number("camera.fov", &v)),
+    /// The camera, or auto-framing (issue 11) when `[camera]` is absent or has
+    /// `fit = true`: then `origin` and `target` are placeholders (the view direction and
+    /// the point it starts from) that `render::build` replaces.
+    fn camera(
+        &mut self,
+        raw: Option<RawCamera>,
+    ) -> Result<(CameraSettings, Option<Framing>), SceneError> {
+        let raw = raw.unwrap_or(RawCamera {
+            origin: None,
+            target: None,
+            up: None,
+            fov: None,
+            fit: None,
+            direction: None,
+        });
+        let up = raw.up.map_or(DVec3::Y, |v| self.vec3("camera.up", &v));
+        let fov = raw
+            .fov
+            .map_or(Camera::DEFAULT_FOV_Y, |v| self.number("camera.fov", &v));
+        let fit = match (&raw.fit, &raw.origin, &raw.target) {
+            (Some(f), _, _) => *f.get_ref(),
+            (None, None, None) => true,
+            (None, _, _) => false,
+        };
+        if fit {
+            if let Some(v) = raw.origin.as_ref().or(raw.target.as_ref()) {
+                return Err(self.invalid(
+                    v.span(),
+                    "camera.fit",
+                    "camera.fit = true places the camera itself: remove camera.origin and                      camera.target, or set fit = false"
+                        .to_string(),
+                ));
+            }
+            let direction = raw
+                .direction
+                .map_or(crate::framing::DEFAULT_DIRECTION, |v| {
+                    self.vec3("camera.direction", &v)
+                });
+            let framing = Framing {
+                direction,
+                up,
+                fov,
+                margin: crate::framing::DEFAULT_MARGIN,
+            };
+            let camera = CameraSettings {
+                origin: direction,
+                target: DVec3::ZERO,
+                up,
+                fov,
+            };
+            return Ok((camera, Some(framing)));
         }
+        if let Some(d) = &raw.direction {
+            return Err(self.invalid(
+                d.span(),
+                "camera.direction",
+                "camera.direction is the view direction of auto-framing: add fit = true, or                  remove it and keep origin and target"
+                    .to_string(),
+            ));
+        }
+        let (Some(origin), Some(target)) = (&raw.origin, &raw.target) else {
+            let given = raw
+                .origin
+                .as_ref()
+                .or(raw.target.as_ref())
+                .expect("one is given");
+            return Err(self.invalid(
+                given.span(),
+                "camera",
+                "[camera] needs both origin and target, or fit = true (or no [camera] at                  all) to frame the scene automatically"
+                    .to_string(),
+            ));
+        };
+        let camera = CameraSettings {
+            origin: self.vec3("camera.origin", origin),
+            target: self.vec3("camera.target", target),
+            up,
+            fov,
+        };
+        Ok((camera, None))
     }
 
     fn image(&mut self, raw: RawImage) -> Result<ImageSettings, SceneError> {
@@ -120,15 +195,20 @@ impl Resolver<'_> {
         };
         let width = size("image.width", raw.width, defaults.width)?;
         let height = size("image.height", raw.height, defaults.height)?;
+        let transparent = raw
+            .background
+            .as_ref()
+            .is_some_and(|v| v.get_ref().as_str() == Some("transparent"));
         let background = match raw.background {
             None => defaults.background,
+            Some(_) if transparent => defaults.background,
             Some(v) => colour(v.get_ref()).ok_or_else(|| {
                 self.invalid(
                     v.span(),
                     "image.background",
                     format!(
-                        "image.background must be [r, g, b] with integers in 0..=255 or a hex \
-                         colour like \"#ffffff\" (got {})",
+                        "image.background must be [r, g, b] with integers in 0..=255, a hex \
+                         colour like \"#ffffff\" or \"transparent\" (got {})",
                         v.get_ref()
                     ),
                 )
@@ -138,11 +218,13 @@ impl Resolver<'_> {
             width,
             height,
             background,
+            transparent,
         })
     }
 
     fn render(&mut self, raw: RawRender) -> Result<RenderSettings, SceneError> {
         let defaults = RenderSettings::default();
+        let (samples, aa, filter) = self.film(&raw)?;
         let beta = raw
             .beta
             .map_or(defaults.beta, |v| self.number("render.beta", &v));
@@ -195,7 +277,47 @@ impl Resolver<'_> {
             max_steps,
             evaluation: raw.evaluation.unwrap_or_default(),
             threads,
+            samples,
+            aa,
+            filter,
         })
+    }
+
+    /// `samples`, `aa` and `filter` of `[render]` (issue 11).
+    fn film(&mut self, raw: &RawRender) -> Result<(u32, AaMode, Filter), SceneError> {
+        let defaults = RenderSettings::default();
+        let samples = match &raw.samples {
+            None => defaults.samples,
+            Some(v) => {
+                let n = *v.get_ref();
+                if let Some(message) = samples_error("render.samples", n) {
+                    return Err(self.invalid(v.span(), "render.samples", message));
+                }
+                let n = u32::try_from(n).expect("checked by samples_error");
+                self.record("render.samples", v.span(), &n);
+                n
+            }
+        };
+        let named = |key: &str, v: &Spanned<String>, names: &str| {
+            format!("{key} must be {names} (got \"{}\")", v.get_ref())
+        };
+        let aa = match &raw.aa {
+            None => defaults.aa,
+            Some(v) => AaMode::from_name(v.get_ref()).ok_or_else(|| {
+                self.invalid(v.span(), "render.aa", named("render.aa", v, AaMode::NAMES))
+            })?,
+        };
+        let filter = match &raw.filter {
+            None => defaults.filter,
+            Some(v) => Filter::from_name(v.get_ref()).ok_or_else(|| {
+                self.invalid(
+                    v.span(),
+                    "render.filter",
+                    named("render.filter", v, Filter::NAMES),
+                )
+            })?,
+        };
+        Ok((samples, aa, filter))
     }
 
     fn object(&mut self, i: usize, raw: Spanned<RawObject>) -> Result<Object, SceneError> {

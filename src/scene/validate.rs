@@ -82,7 +82,49 @@ impl Checker<'_> {
         self.fail_at(&[(field, value)], field, message)
     }
 
+    /// Auto-framing: the view direction must be finite, non-zero and across `up`.
+    fn framing(&self, f: &crate::framing::Framing) -> Result<(), SceneError> {
+        let Err(e) = check_view(f.direction, DVec3::ZERO, f.up, f.fov) else {
+            return Ok(());
+        };
+        let d = &f.direction;
+        Err(match e {
+            CameraError::NonFinite { what: "up", .. } => self.fail(
+                "camera.up",
+                &f.up,
+                format!("camera.up must be finite (got {})", fmt_vec(f.up)),
+            ),
+            CameraError::NonFinite { .. } | CameraError::OriginIsTarget { .. } => self.fail(
+                "camera.direction",
+                d,
+                format!(
+                    "camera.direction must be a finite, non-zero vector (got {})",
+                    fmt_vec(*d)
+                ),
+            ),
+            CameraError::UpParallel { .. } => self.fail_at(
+                &[("camera.up", &f.up), ("camera.direction", d)],
+                "camera.up",
+                format!(
+                    "camera.up {} is zero or parallel to camera.direction {}; choose a \
+                     direction across up",
+                    fmt_vec(f.up),
+                    fmt_vec(*d)
+                ),
+            ),
+            CameraError::FieldOfView(fov) => self.fail(
+                "camera.fov",
+                &f.fov,
+                format!("camera.fov must be in (0, 180) degrees (got {fov})"),
+            ),
+            other @ CameraError::EmptyImage { .. } => self.fail("camera", &(), other.to_string()),
+        })
+    }
+
     fn camera(&self) -> Result<(), SceneError> {
+        if let Some(f) = &self.scene.framing {
+            return self.framing(f);
+        }
         let c = &self.scene.camera;
         let Err(e) = check_view(c.origin, c.target, c.up, c.fov) else {
             return Ok(());
@@ -161,6 +203,11 @@ impl Checker<'_> {
         }
         if let Some(message) = max_steps_error(i64::from(r.max_steps)) {
             return Err(self.fail("render.max_steps", &r.max_steps, message));
+        }
+        if let Some(message) =
+            crate::film::options::samples_error("render.samples", r.samples.into())
+        {
+            return Err(self.fail("render.samples", &r.samples, message));
         }
         Ok(())
     }

@@ -15,10 +15,12 @@
 use super::ServeError;
 use super::view::{Aov, ViewRequest, probe_pixel};
 use crate::eval;
+use crate::film::aov::AovBuffers;
+use crate::film::{FilmOptions, heatmap};
 use crate::matcap::{MatCap, MatCapSpec};
 use crate::primitives::PrimitiveKind;
 use crate::render::build::{BuiltScene, build_scene, object_alphas};
-use crate::render::image::{ImageStats, Rendered, render_cancellable};
+use crate::render::image::{ImageStats, Rendered, render_film};
 use crate::render::{Tracer, TracerOptions};
 use crate::scene::Scene;
 use serde::Serialize;
@@ -180,9 +182,6 @@ impl Jobs {
 
     /// Renders one pass of `view` (already applied to the scene as `scene`).
     pub fn render(&self, view: &ViewRequest, scene: &Scene) -> Result<PassImage, ServeError> {
-        if let Some(message) = view.unavailable() {
-            return Err(ServeError::BadRequest(message));
-        }
         let generation = (!view.keep).then(|| self.newest.fetch_add(1, Ordering::SeqCst) + 1);
         let cancelled = || generation.is_some_and(|g| self.newest.load(Ordering::SeqCst) != g);
         let (w, h) = view.pass_size(scene);
@@ -198,14 +197,17 @@ impl Jobs {
             self.counters
                 .renders_started
                 .fetch_add(1, Ordering::Relaxed);
-            let rendered = render_cancellable(
-                &tracer,
-                &camera,
-                &built.shaders,
-                scene.image.background,
-                &|_| {},
-                &cancelled,
-            );
+            let film = FilmOptions {
+                samples: view.samples,
+                aa: scene.render.aa,
+                filter: scene.render.filter,
+                background: scene.image.background,
+                transparent: false,
+                crop: None,
+                keep_aovs: !matches!(view.aov, Aov::Shaded | Aov::Depth),
+            };
+            let rendered =
+                render_film(&tracer, &camera, &built.shaders, &film, &|_| {}, &cancelled);
             let Some(rendered) = rendered else {
                 self.counters
                     .renders_cancelled
@@ -215,7 +217,12 @@ impl Jobs {
             self.counters
                 .renders_finished
                 .fetch_add(1, Ordering::Relaxed);
-            let png = encode(&rendered, view.aov, scene.image.background)?;
+            let png = encode(
+                &rendered,
+                view.aov,
+                scene.image.background,
+                built.objects.len(),
+            )?;
             Ok(PassImage {
                 png,
                 stats: rendered.stats,
@@ -282,17 +289,71 @@ impl Jobs {
     }
 }
 
-/// The pass as PNG bytes: the shaded image, or the depth view.
-fn encode(r: &Rendered, aov: Aov, background: [u8; 3]) -> Result<Vec<u8>, ServeError> {
+/// The pass as PNG bytes: the shaded image, or one of the AOV views (depth as grey,
+/// normals as colours, object ids as a palette, positions scaled to the hits' box, the
+/// cost heat map with its scale).
+fn encode(
+    r: &Rendered,
+    aov: Aov,
+    background: [u8; 3],
+    objects: usize,
+) -> Result<Vec<u8>, ServeError> {
+    let internal = |e: String| ServeError::Internal(e);
+    let aovs = || {
+        r.aovs
+            .as_ref()
+            .ok_or_else(|| internal("the render kept no AOV records".into()))
+    };
     let image = match aov {
-        Aov::Depth => depth_image(r, background),
-        _ => r.image.clone(),
+        Aov::Shaded => r.to_dynamic(),
+        Aov::Depth => image::DynamicImage::ImageRgb8(depth_image(r, background)),
+        Aov::Normal => aovs()?.normal(),
+        Aov::Id => return aovs()?.id_png(objects).map_err(ServeError::BadRequest),
+        Aov::Position => image::DynamicImage::ImageRgba8(position_image(aovs()?)),
+        Aov::Cost => {
+            let b = aovs()?;
+            image::DynamicImage::ImageRgb8(
+                heatmap::heat_map(&b.costs(), b.width, b.height).map_err(internal)?,
+            )
+        }
     };
     let mut png = Vec::new();
     image
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .map_err(|e| ServeError::Internal(format!("cannot encode the PNG: {e}")))?;
     Ok(png)
+}
+
+/// World positions as colours: each coordinate scaled over the box of the hits, alpha 0
+/// for misses.
+fn position_image(b: &AovBuffers) -> image::RgbaImage {
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for r in b.records.iter().filter(|r| r.is_hit()) {
+        for a in 0..3 {
+            lo[a] = lo[a].min(r.position[a]);
+            hi[a] = hi[a].max(r.position[a]);
+        }
+    }
+    let data = b
+        .records
+        .iter()
+        .flat_map(|r| {
+            if !r.is_hit() {
+                return [0; 4];
+            }
+            let c = |a: usize| {
+                let span = hi[a] - lo[a];
+                let v = if span > 0.0 {
+                    (r.position[a] - lo[a]) / span
+                } else {
+                    0.5
+                };
+                (255.0 * v).round().clamp(0.0, 255.0) as u8
+            };
+            [c(0), c(1), c(2), 255]
+        })
+        .collect();
+    image::RgbaImage::from_raw(b.width, b.height, data).expect("size")
 }
 
 /// Hit distance as grey: the nearest hit white, the farthest dark grey, misses in the
@@ -353,7 +414,10 @@ mod tests {
     fn depth_view_orders_near_to_far() {
         let r = Rendered {
             image: image::RgbImage::new(3, 1),
+            alpha: None,
             depth: vec![1.0, 3.0, f32::INFINITY],
+            aovs: None,
+            region: crate::film::crop::Rect::full(3, 1),
             stats: ImageStats::default(),
         };
         let img = depth_image(&r, [1, 2, 3]);

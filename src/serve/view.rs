@@ -59,13 +59,13 @@ pub enum Aov {
     Shaded,
     /// Hit distance along the ray, near bright, far dark.
     Depth,
-    /// Normals as colours (not in this build).
+    /// World normals as colours (`0.5 + 0.5 n`).
     Normal,
-    /// Object and primitive ids (not in this build).
+    /// Object index as a palette.
     Id,
-    /// Hit positions (not in this build).
+    /// Hit positions as colours, scaled over the box of the hits.
     Position,
-    /// Work per pixel as a heat map (not in this build).
+    /// Evaluations per pixel as a heat map with its scale.
     Cost,
 }
 
@@ -213,25 +213,6 @@ impl ViewRequest {
             scene.image.width.div_ceil(self.scale),
             scene.image.height.div_ceil(self.scale),
         )
-    }
-
-    /// The features this build cannot render yet, as a 400 message.
-    pub fn unavailable(&self) -> Option<String> {
-        if self.samples > 1 {
-            return Some(format!(
-                "samples = {}: anti-aliasing is not available in this build (use samples = 1)",
-                self.samples
-            ));
-        }
-        match self.aov {
-            Aov::Shaded | Aov::Depth => None,
-            other => Some(format!(
-                "aov = {}: not available in this build (shaded and depth are)",
-                serde_json::to_string(&other)
-                    .unwrap_or_default()
-                    .trim_matches('"')
-            )),
-        }
     }
 }
 
