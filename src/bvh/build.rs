@@ -34,6 +34,8 @@ struct Input<'a> {
     bounds: &'a [Aabb],
     centroids: &'a [Vec3],
     leaf_size: usize,
+    /// Every primitive's box is its centroid (points): binning skips the boxes.
+    points: bool,
 }
 
 /// Bounds of a range: of its primitives and of their centroids.
@@ -57,10 +59,15 @@ pub fn build_binary(bounds: &[Aabb], centroids: &[Vec3], options: BuildOptions) 
     if bounds.is_empty() {
         return Bvh::default();
     }
+    let points = bounds
+        .par_iter()
+        .zip(centroids.par_iter())
+        .all(|(b, &c)| b.min == c && b.max == c);
     let input = Input {
         bounds,
         centroids,
         leaf_size: options.leaf_size.max(1),
+        points,
     };
     let mut order: Vec<u32> = (0..bounds.len() as u32).collect();
     let rb = bounds
@@ -222,12 +229,14 @@ fn split(input: &Input, items: &mut [u32], rb: RangeBounds) -> (usize, RangeBoun
         for &i in chunk {
             let k = bin_of(i);
             b.count[k] += 1;
-            b.prims[k] = b.prims[k].union(input.bounds[i as usize]);
+            if !input.points {
+                b.prims[k] = b.prims[k].union(input.bounds[i as usize]);
+            }
             b.centroids[k] = b.centroids[k].grow(input.centroids[i as usize]);
         }
         b
     };
-    let bins = if items.len() >= PARALLEL_BINNING_MIN {
+    let mut bins = if items.len() >= PARALLEL_BINNING_MIN {
         items
             .par_chunks(64 * 1024)
             .map(bin_all)
@@ -235,6 +244,9 @@ fn split(input: &Input, items: &mut [u32], rb: RangeBounds) -> (usize, RangeBoun
     } else {
         bin_all(items)
     };
+    if input.points {
+        bins.prims = bins.centroids;
+    }
     // Suffix costs from the right, then the best split from the left.
     let mut right_cost = [0f32; BINS];
     let (mut acc_b, mut acc_n) = (Aabb::EMPTY, 0usize);
@@ -273,7 +285,13 @@ fn split(input: &Input, items: &mut [u32], rb: RangeBounds) -> (usize, RangeBoun
         )
     };
     let mid: usize = bins.count[..=best].iter().sum();
-    partition(items, |i| bin_of(i) <= best);
+    // `bin_of(i) <= best` without the integer conversion: the bin index is the scaled
+    // offset truncated (0 below the range, NaN included), and best + 1 < BINS.
+    let cut = (best + 1) as f32;
+    partition(items, |i| {
+        let v = (input.centroids[i as usize][axis] - lo) * scale;
+        v < cut || v.is_nan()
+    });
     (mid, gather(0..best + 1), gather(best + 1..BINS))
 }
 
