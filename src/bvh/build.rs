@@ -93,7 +93,9 @@ pub fn build_binary(bounds: &[Aabb], centroids: &[Vec3], options: BuildOptions) 
                 centroids: a.centroids.union(b.centroids),
             },
         );
-    let nodes = build_range(&input, &mut order, 0, rb);
+    let built = build_range(&input, &mut order, 0, rb);
+    let mut nodes = Vec::with_capacity(built.len());
+    built.flatten(&mut nodes);
     Bvh {
         nodes,
         order,
@@ -101,13 +103,52 @@ pub fn build_binary(bounds: &[Aabb], centroids: &[Vec3], options: BuildOptions) 
     }
 }
 
-/// Builds the subtree over `items` (which start at `offset` in the final order) into a
-/// fresh vector whose child indices are relative to its start.
-fn build_range(input: &Input, items: &mut [u32], offset: usize, rb: RangeBounds) -> Vec<Node> {
+/// A subtree as built in parallel: serial pieces (child indices relative to the piece's
+/// start) joined by the nodes above them, laid out depth-first once at the end
+/// ([`Built::flatten`]), so each node is copied once rather than once per level.
+enum Built {
+    Serial(Vec<Node>),
+    Split(Node, Box<Built>, Box<Built>),
+}
+
+impl Built {
+    fn len(&self) -> usize {
+        match self {
+            Built::Serial(v) => v.len(),
+            Built::Split(_, l, r) => 1 + l.len() + r.len(),
+        }
+    }
+
+    /// Appends the subtree depth-first to `out`, fixing the right-child indices.
+    fn flatten(self, out: &mut Vec<Node>) {
+        match self {
+            Built::Serial(v) => {
+                let base = out.len() as u32;
+                out.extend(v.into_iter().map(|mut n| {
+                    if !n.is_leaf() {
+                        n.index += base;
+                    }
+                    n
+                }));
+            }
+            Built::Split(node, l, r) => {
+                let here = out.len();
+                out.push(node);
+                l.flatten(out);
+                out[here].index = out.len() as u32;
+                r.flatten(out);
+            }
+        }
+    }
+}
+
+/// Builds the subtree over `items` (which start at `offset` in the final order), in
+/// parallel above `PARALLEL_MIN` items.
+fn build_range(input: &Input, items: &mut [u32], offset: usize, rb: RangeBounds) -> Built {
     if items.len() < PARALLEL_MIN {
         let mut nodes = Vec::with_capacity(2 * items.len() / input.leaf_size + 1);
         build_serial(input, items, offset, rb, &mut nodes);
-        return nodes;
+        return Built::Serial(nodes);
     }
     let (mid, left_rb, right_rb) = split(input, items, rb);
     let (left_items, right_items) = items.split_at_mut(mid);
@@ -115,22 +156,8 @@ fn build_range(input: &Input, items: &mut [u32], offset: usize, rb: RangeBounds)
         || build_range(input, left_items, offset, left_rb),
         || build_range(input, right_items, offset + mid, right_rb),
     );
-    let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
-    nodes.push(make_node(rb.prims, (1 + left.len()) as u32, 0, items.len()));
-    append_shifted(&mut nodes, left);
-    append_shifted(&mut nodes, right);
-    nodes
-}
-
-/// Appends a subtree vector, shifting its inner nodes' right-child indices.
-fn append_shifted(nodes: &mut Vec<Node>, sub: Vec<Node>) {
-    let base = nodes.len() as u32;
-    nodes.extend(sub.into_iter().map(|mut n| {
-        if !n.is_leaf() {
-            n.index += base;
-        }
-        n
-    }));
+    let node = make_node(rb.prims, 0, 0, items.len());
+    Built::Split(node, Box::new(left), Box::new(right))
 }
 
 fn build_serial(
