@@ -2,6 +2,9 @@
 //! the bound value (coarse beta), the full value and the exact (beta 0) value, so the
 //! final approach can be studied. Run:
 //! `cargo run --release --example ray_probe -- scenes/deer_alpha1.toml [W H]`
+//! Other modes, after `W H`: `PX PY` (one pixel with and without relaxed steps, and the
+//! field around its hit), `evalstats` (exact, far, pruned terms and nodes per full
+//! evaluation near hits), `histogram` (full evaluations per hit ray).
 use glam::DVec3;
 use smoothtrace::eval::evaluate_value;
 use smoothtrace::render::build::build_scene;
@@ -54,6 +57,23 @@ fn main() {
                 println!("  s_BH/s_exact around the hit, steps of eps/2 (in eps): {line}");
             }
         }
+        return;
+    }
+    if args.get(4).map(String::as_str) == Some("histogram") {
+        // Full evaluations per hit ray, traced alone from the camera's clearance.
+        let mut hist = [0u32; 12];
+        let mut st = RayStats::default();
+        let (s0, _) = tracer.field(cam.origin(), &mut st);
+        for py in 0..h {
+            for px in 0..w {
+                let (o, d) = cam.ray(px, py);
+                let r = tracer.trace(o, d, s0);
+                if r.hit.is_some() {
+                    hist[(r.stats.evals as usize).min(11)] += 1;
+                }
+            }
+        }
+        println!("full evaluations per hit ray (0..10, 11+): {hist:?}");
         return;
     }
     if args.get(4).map(String::as_str) == Some("evalstats") {
