@@ -76,6 +76,9 @@ pub struct ImageStats {
     pub nodes: u64,
     pub falloffs: u64,
     pub backtracks: u64,
+    /// Over-relaxed steps the next sample did not certify (the ray went back to the
+    /// plain step; their evaluations are counted in `evals` and `coarse_evals`).
+    pub rejected_steps: u64,
     /// The camera origin is inside the surface (the image is all background).
     pub camera_inside: bool,
     /// Bound evaluations on tile axes (cone marching), shared by the tile's rays;
@@ -101,6 +104,7 @@ impl ImageStats {
         self.nodes += st.eval.nodes as u64;
         self.falloffs += st.falloffs as u64;
         self.backtracks += st.backtracks as u64;
+        self.rejected_steps += st.rejected_steps as u64;
         self.exhausted += st.exhausted as u64;
         if r.hit.is_some() {
             self.hits += 1;
@@ -129,6 +133,7 @@ impl ImageStats {
         self.nodes += o.nodes;
         self.falloffs += o.falloffs;
         self.backtracks += o.backtracks;
+        self.rejected_steps += o.rejected_steps;
         self.tile_evals += o.tile_evals;
         self.shade_cpu_seconds += o.shade_cpu_seconds;
     }
