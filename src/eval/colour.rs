@@ -28,13 +28,8 @@ pub fn colour_at(
     x: DVec3,
     p: &EvalParams,
 ) -> Option<Linear> {
-    let total: usize = sets.iter().map(|s| s.len()).sum();
     let scale = |s: &AnySet| WeightScale::new(s.max_adj(), p.alpha, p.max_alpha);
-    let w_max = sets
-        .iter()
-        .map(|s| scale(s).max_weight())
-        .fold(1.0, f64::max);
-    let prune_margin = (total.max(1) as f64 * w_max / COLOUR_TOLERANCE).ln() / p.alpha;
+    let prune_margin = super::smooth::prune_margin(sets, p, COLOUR_TOLERANCE);
     let mut acc = Blend::new(p.alpha);
     for (set, cols) in sets.iter().zip(colours) {
         let sc = scale(set);

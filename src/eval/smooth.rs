@@ -121,17 +121,25 @@ pub fn evaluate_value(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
     evaluate_impl::<false>(sets, x, p)
 }
 
+/// `ln(N w_max / tol) / alpha` for the `N` primitives of `sets` and their largest
+/// weight: a subtree farther than `m + margin - ln(S) / alpha` (module docs) holds less
+/// than `tol S / N` per primitive, so all such subtrees together hold less than `tol` of
+/// the sum. Shared with the colour traversal (`eval::colour`).
+pub(crate) fn prune_margin(sets: &[&AnySet], p: &EvalParams, tol: f64) -> f64 {
+    let total: usize = sets.iter().map(|s| s.len()).sum();
+    let w_max = sets
+        .iter()
+        .map(|s| WeightScale::new(s.max_adj(), p.alpha, p.max_alpha).max_weight())
+        .fold(1.0, f64::max);
+    (total.max(1) as f64 * w_max / tol).ln() / p.alpha
+}
+
 fn evaluate_impl<const GRAD: bool>(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
     let mut acc = Accumulator::new(p.alpha, p.accumulation);
     let mut stats = EvalStats::default();
-    let total: usize = sets.iter().map(|s| s.len()).sum();
     let scale = |s: &AnySet| WeightScale::new(s.max_adj(), p.alpha, p.max_alpha);
-    let w_max = sets
-        .iter()
-        .map(|s| scale(s).max_weight())
-        .fold(1.0, f64::max);
     let prune_margin = if p.prune {
-        (total.max(1) as f64 * w_max / p.prune_tolerance).ln() / p.alpha
+        prune_margin(sets, p, p.prune_tolerance)
     } else {
         f64::INFINITY
     };
