@@ -76,6 +76,84 @@ fn main() {
         println!("full evaluations per hit ray (0..10, 11+): {hist:?}");
         return;
     }
+    if args.get(4).map(String::as_str) == Some("cgf") {
+        // Step bounds at points before the hit, from the exact sum over all points:
+        // plain s, the Hoeffding quadratic root, the exact cumulant bound
+        // s + K(L) > 0 (K(L) = -ln E_p[exp(-alpha a L)] / alpha, a = d/dt of each
+        // distance), and the distance left to the hit.
+        let smoothtrace::primitives::AnySet::Points(ps) = sets[0] else {
+            panic!("points only")
+        };
+        let alpha = obj.params.alpha;
+        let pts: Vec<DVec3> = ps.prims.iter().map(|q| q.p.as_dvec3()).collect();
+        let mut rows: Vec<[f64; 5]> = Vec::new();
+        for py in (0..h).step_by(6) {
+            for px in (0..w).step_by(6) {
+                let (o, d) = cam.ray(px, py);
+                let Some(hit) = tracer.trace(o, d, 0.0).hit else {
+                    continue;
+                };
+                for back in [1.5, 3.0, 6.0, 12.0, 24.0, 48.0, 96.0] {
+                    let t = hit.t - back * eps;
+                    let x = o + t * d;
+                    let ds: Vec<(f64, f64)> = pts
+                        .iter()
+                        .map(|q| {
+                            let v = x - *q;
+                            let l = v.length();
+                            (l, v.dot(d) / l.max(1e-300))
+                        })
+                        .collect();
+                    let m = ds.iter().map(|e| e.0).fold(f64::INFINITY, f64::min);
+                    let sum: f64 = ds.iter().map(|e| (-alpha * (e.0 - m)).exp()).sum();
+                    let s0 = m - sum.ln() / alpha;
+                    if s0 <= 0.0 {
+                        continue;
+                    }
+                    let mu: f64 = ds
+                        .iter()
+                        .map(|e| (-alpha * (e.0 - m)).exp() * e.1)
+                        .sum::<f64>()
+                        / sum;
+                    let bound = |l: f64| {
+                        let e: f64 = ds
+                            .iter()
+                            .map(|e| (-alpha * (e.0 - m) - alpha * e.1 * l).exp())
+                            .sum::<f64>()
+                            / sum;
+                        s0 - e.ln() / alpha
+                    };
+                    let (mut lo, mut hi) = (0.0, 2.0 * (hit.t - t) + 4.0 * s0);
+                    for _ in 0..40 {
+                        let mid = 0.5 * (lo + hi);
+                        if bound(mid) > 0.0 {
+                            lo = mid
+                        } else {
+                            hi = mid
+                        }
+                    }
+                    let quad = (mu + (mu * mu + 2.0 * alpha * s0).sqrt()) / alpha;
+                    rows.push([s0 / eps, quad.max(s0) / s0, lo / s0, (hit.t - t) / s0, -mu]);
+                }
+            }
+        }
+        for (lo, hi) in [(1.0, 2.0), (2.0, 4.0), (4.0, 8.0), (8.0, 16.0), (16.0, 32.0), (32.0, 64.0), (64.0, 1e9)] {
+            let sel: Vec<&[f64; 5]> = rows.iter().filter(|r| r[0] >= lo && r[0] < hi).collect();
+            let n = sel.len() as f64;
+            if n == 0.0 {
+                continue;
+            }
+            let mean = |k: usize| sel.iter().map(|r| r[k]).sum::<f64>() / n;
+            println!(
+                "s/eps in [{lo}, {hi}): {n} samples; step / s: quadratic {:.2}, cumulant {:.2}, to the hit {:.2}; slope -mu {:.2}",
+                mean(1),
+                mean(2),
+                mean(3),
+                mean(4)
+            );
+        }
+        return;
+    }
     if args.get(4).map(String::as_str) == Some("evalstats") {
         let mut sum = [0f64; 5];
         let mut n = 0.0;
@@ -88,7 +166,7 @@ fn main() {
                 };
                 for back in [0.0, 4.0, 16.0] {
                     let x = hit.point - back * eps * d;
-                    let e = obj.evaluate(&sets, x, obj.params.alpha, None, tol, false);
+                    let e = obj.evaluate(&sets, x, obj.params.alpha, obj.params.beta, tol, false);
                     let st = e.stats;
                     sum[0] += st.exact as f64;
                     sum[1] += st.far as f64;

@@ -79,6 +79,9 @@ pub struct ImageStats {
     /// Over-relaxed steps the next sample did not certify (the ray went back to the
     /// plain step; their evaluations are counted in `evals` and `coarse_evals`).
     pub rejected_steps: u64,
+    /// Accurate re-evaluations of samples whose Barnes-Hut value fell in the hit band
+    /// or below (included in `evals`; see `render::tracer`).
+    pub refinements: u64,
     /// The camera origin is inside the surface (the image is all background).
     pub camera_inside: bool,
     /// Bound evaluations on tile axes (cone marching), shared by the tile's rays;
@@ -105,6 +108,7 @@ impl ImageStats {
         self.falloffs += st.falloffs as u64;
         self.backtracks += st.backtracks as u64;
         self.rejected_steps += st.rejected_steps as u64;
+        self.refinements += st.refinements as u64;
         self.exhausted += st.exhausted as u64;
         if r.hit.is_some() {
             self.hits += 1;
@@ -134,6 +138,7 @@ impl ImageStats {
         self.falloffs += o.falloffs;
         self.backtracks += o.backtracks;
         self.rejected_steps += o.rejected_steps;
+        self.refinements += o.refinements;
         self.tile_evals += o.tile_evals;
         self.shade_cpu_seconds += o.shade_cpu_seconds;
     }

@@ -58,24 +58,23 @@ impl TraceObject {
     }
 
     /// Evaluates the smooth distance with the object's parameters, alpha possibly
-    /// replaced (the naive mode's falloff), beta possibly coarsened (a coarser
-    /// Barnes-Hut sum is a lower bound of a finer one) and the pruning tolerance possibly
-    /// raised (a lower bound too, see `eval::smooth`), with the gradient if `grad`.
+    /// replaced (the naive mode's falloff), at opening parameter `beta` (the tracer's
+    /// bound steps take a coarser one, a lower bound of the scene's sum; its hit
+    /// decisions a finer one) and the pruning tolerance possibly raised (a lower bound
+    /// too, see `eval::smooth`), with the gradient if `grad`.
     pub fn evaluate(
         &self,
         sets: &[&AnySet],
         x: DVec3,
         alpha: f64,
-        beta: Option<f64>,
+        beta: f64,
         prune_tolerance: f64,
         grad: bool,
     ) -> Sample {
         let mut p = self.params;
         p.alpha = alpha;
+        p.beta = beta;
         p.prune_tolerance = p.prune_tolerance.max(prune_tolerance);
-        if let Some(b) = beta {
-            p.beta = b.max(p.beta);
-        }
         if grad {
             eval::evaluate(sets, x, &p)
         } else {
