@@ -86,7 +86,7 @@ fn main() {
         };
         let alpha = obj.params.alpha;
         let pts: Vec<DVec3> = ps.prims.iter().map(|q| q.p.as_dvec3()).collect();
-        let mut rows: Vec<[f64; 5]> = Vec::new();
+        let mut rows: Vec<[f64; 7]> = Vec::new();
         for py in (0..h).step_by(6) {
             for px in (0..w).step_by(6) {
                 let (o, d) = cam.ray(px, py);
@@ -126,30 +126,107 @@ fn main() {
                     let (mut lo, mut hi) = (0.0, 2.0 * (hit.t - t) + 4.0 * s0);
                     for _ in 0..40 {
                         let mid = 0.5 * (lo + hi);
-                        if bound(mid) > 0.0 {
-                            lo = mid
-                        } else {
-                            hi = mid
-                        }
+                        if bound(mid) > 0.0 { lo = mid } else { hi = mid }
                     }
                     let quad = (mu + (mu * mu + 2.0 * alpha * s0).sqrt()) / alpha;
-                    rows.push([s0 / eps, quad.max(s0) / s0, lo / s0, (hit.t - t) / s0, -mu]);
+                    // Bennett: E exp(-aL A) <= exp(-aL mu + var/b^2 (e^{aLb} - 1 - aLb)),
+                    // b = 1 + mu.
+                    let var: f64 = ds
+                        .iter()
+                        .map(|e| (-alpha * (e.0 - m)).exp() * (e.1 - mu) * (e.1 - mu))
+                        .sum::<f64>()
+                        / sum;
+                    let bb = (1.0 + mu).max(1e-12);
+                    let bennett = |l: f64| {
+                        let y = alpha * l * bb;
+                        s0 + mu * l - var / (alpha * bb * bb) * (y.exp() - 1.0 - y)
+                    };
+                    let (mut blo, mut bhi) = (0.0, 2.0 * (hit.t - t) + 4.0 * s0);
+                    for _ in 0..60 {
+                        let mid = 0.5 * (blo + bhi);
+                        if bennett(mid) > 0.0 {
+                            blo = mid
+                        } else {
+                            bhi = mid
+                        }
+                    }
+                    // What the evaluator computes (eval::reach).
+                    let mut slopes = smoothtrace::eval::reach::Slopes::default();
+                    for e in &ds {
+                        slopes.add((-alpha * (e.0 - m)).exp(), e.1);
+                    }
+                    let binned = slopes.free_distance(s0, m, alpha, 0.0, 1e9);
+                    rows.push([
+                        s0 / eps,
+                        quad.max(s0) / s0,
+                        lo / s0,
+                        (hit.t - t) / s0,
+                        -mu,
+                        blo.max(s0) / s0,
+                        binned / s0,
+                    ]);
                 }
             }
         }
-        for (lo, hi) in [(1.0, 2.0), (2.0, 4.0), (4.0, 8.0), (8.0, 16.0), (16.0, 32.0), (32.0, 64.0), (64.0, 1e9)] {
-            let sel: Vec<&[f64; 5]> = rows.iter().filter(|r| r[0] >= lo && r[0] < hi).collect();
+        for (lo, hi) in [
+            (1.0, 2.0),
+            (2.0, 4.0),
+            (4.0, 8.0),
+            (8.0, 16.0),
+            (16.0, 32.0),
+            (32.0, 64.0),
+            (64.0, 1e9),
+        ] {
+            let sel: Vec<&[f64; 7]> = rows.iter().filter(|r| r[0] >= lo && r[0] < hi).collect();
             let n = sel.len() as f64;
             if n == 0.0 {
                 continue;
             }
             let mean = |k: usize| sel.iter().map(|r| r[k]).sum::<f64>() / n;
             println!(
-                "s/eps in [{lo}, {hi}): {n} samples; step / s: quadratic {:.2}, cumulant {:.2}, to the hit {:.2}; slope -mu {:.2}",
+                "s/eps in [{lo}, {hi}): {n} samples; step / s: quadratic {:.2}, Bennett {:.2}, eval::reach {:.2}, cumulant {:.2}, to the hit {:.2}; slope -mu {:.2}",
                 mean(1),
+                mean(5),
+                mean(6),
                 mean(2),
                 mean(3),
                 mean(4)
+            );
+        }
+        return;
+    }
+    if args.get(4).map(String::as_str) == Some("cost") {
+        // Time per evaluation near hits: value only, value with the free distance,
+        // with the gradient.
+        let mut xs = Vec::new();
+        for py in (0..h).step_by(2) {
+            for px in (0..w).step_by(2) {
+                let (o, d) = cam.ray(px, py);
+                if let Some(hit) = tracer.trace(o, d, 0.0).hit {
+                    for back in [2.0, 8.0, 32.0] {
+                        xs.push((hit.point - back * eps * d, d));
+                    }
+                }
+            }
+        }
+        let mut p = obj.params;
+        p.prune_tolerance = (0.005 * p.alpha * eps).min(1e-3);
+        for mode in [0, 1, 2, 0, 1, 2] {
+            let start = std::time::Instant::now();
+            let mut acc = 0.0;
+            for _ in 0..3 {
+                for &(x, d) in &xs {
+                    acc += match mode {
+                        0 => evaluate_value(&sets, x, &p).s,
+                        1 => smoothtrace::eval::evaluate_reach(&sets, x, d, &p, 1e9, false).reach,
+                        _ => smoothtrace::eval::evaluate(&sets, x, &p).s,
+                    };
+                }
+            }
+            println!(
+                "{}: {:.3} us per evaluation ({acc:.1})",
+                ["value", "value+reach", "gradient"][mode],
+                start.elapsed().as_secs_f64() * 1e6 / (3 * xs.len()) as f64
             );
         }
         return;
@@ -166,7 +243,15 @@ fn main() {
                 };
                 for back in [0.0, 4.0, 16.0] {
                     let x = hit.point - back * eps * d;
-                    let e = obj.evaluate(&sets, x, obj.params.alpha, obj.params.beta, tol, false);
+                    let e = obj.evaluate(
+                        &sets,
+                        x,
+                        obj.params.alpha,
+                        obj.params.beta,
+                        tol,
+                        false,
+                        None,
+                    );
                     let st = e.stats;
                     sum[0] += st.exact as f64;
                     sum[1] += st.far as f64;

@@ -7,7 +7,8 @@
 //!   rays hitting in both within 4 epsilon). Thin features (the net's and hex torus'
 //!   tubes, the bucky ball's struts, the spiky sphere's spikes) are where a skipped
 //!   surface would show. Over-relaxed steps (`TracerOptions::relax`) likewise against
-//!   plain sphere-tracing steps.
+//!   plain sphere-tracing steps, and steps by the free distance from the terms' slopes
+//!   (`TracerOptions::reach_steps`, point clouds) against plain steps.
 //! - At beta 0.5 the rendered surface stays close to the exact (beta 0) one: median depth
 //!   error at most 0.1% of the scene's diagonal on the procedural scenes and the bunny,
 //!   and on the full bunny's edges at its native size, where that needs hits decided at
@@ -106,6 +107,62 @@ fn relaxed_steps_find_the_surface_plain_steps_find() {
             "{name}: relaxed {} vs plain {} evaluations",
             all(&relaxed),
             all(&plain)
+        );
+    }
+}
+
+#[test]
+fn reach_steps_find_the_surface_plain_steps_find() {
+    let mut names = vec!["sphere_points.toml"];
+    if common::data_file("bunny-7k.obj").is_some() {
+        names.push("bunny_points.toml");
+    } else {
+        eprintln!("skipping bunny_points.toml: data/bunny-7k.obj is absent");
+    }
+    if common::data_file("igea-points-134k.ply").is_some() {
+        names.push("deer_alpha1.toml");
+    } else {
+        eprintln!("skipping deer_alpha1.toml: data/igea-points-134k.ply is absent");
+    }
+    let plain = |o| TracerOptions {
+        reach_steps: false,
+        ..o
+    };
+    for name in names {
+        let s = scene(name, 240, 135);
+        let (eps, _, reach) = render(&s, |o| o);
+        let (_, _, stepped) = render(&s, plain);
+        // Both against the exact sum's surface (beta 0, plain steps), in epsilons.
+        let mut exact = s.clone();
+        exact.render.beta = 0.0;
+        let (_, _, exact) = render(&exact, plain);
+        let (a, b) = (
+            compare_depths(&reach.depth, &exact.depth, 1.0, eps),
+            compare_depths(&stepped.depth, &exact.depth, 1.0, eps),
+        );
+        eprintln!("{name}: vs exact, reach steps {a:?}\n   plain steps {b:?}");
+        assert!(
+            a.only_one <= b.only_one + reach.stats.rays as usize / 500,
+            "{name}: {} rays hit in only one of the reach and exact renders, {} with plain steps",
+            a.only_one,
+            b.only_one
+        );
+        assert!(
+            a.p50.unwrap() <= b.p50.unwrap() + 0.5 && a.p99.unwrap() <= b.p99.unwrap() + 1.0,
+            "{name}: depth error against the exact surface, reach {a:?} vs plain {b:?}"
+        );
+        // The point of it: fewer full evaluations on the rays that hit.
+        let per_hit = |r: &Rendered| r.stats.hit_evals as f64 / r.stats.hits as f64;
+        eprintln!(
+            "{name}: full evaluations per hit ray {:.2} -> {:.2}",
+            per_hit(&stepped),
+            per_hit(&reach)
+        );
+        assert!(
+            per_hit(&reach) < 0.8 * per_hit(&stepped),
+            "{name}: {:.2} vs {:.2} full evaluations per hit ray",
+            per_hit(&reach),
+            per_hit(&stepped)
         );
     }
 }

@@ -49,8 +49,9 @@ impl Accumulator {
 
     /// Adds the term `w exp(-alpha d)` with unit direction `dir` (gradient of `d`) and
     /// weight gradient `grad_w`.
+    /// Returns the term as added to the shifted sum, `w exp(-alpha (d - m))`.
     #[inline]
-    pub fn add(&mut self, d: f64, w: f64, dir: DVec3, grad_w: DVec3) {
+    pub fn add(&mut self, d: f64, w: f64, dir: DVec3, grad_w: DVec3) -> f64 {
         let inv_alpha = 1.0 / self.alpha;
         if d < self.m {
             // exp(-inf) = 0 on the first term, when s and g are still zero.
@@ -68,20 +69,37 @@ impl Accumulator {
             self.naive_s += w * e;
             self.naive_g += e * gterm;
         }
+        w * e
     }
 
-    /// Adds the term `w exp(-alpha d)` to the value sums only (no gradient).
+    /// Adds the term `w exp(-alpha d)` to the value sums only (no gradient); returns the
+    /// term as added to the shifted sum, `w exp(-alpha (d - m))`.
     #[inline]
-    pub fn add_value(&mut self, d: f64, w: f64) {
+    pub fn add_value(&mut self, d: f64, w: f64) -> f64 {
         if d < self.m {
             let rescale = (-self.alpha * (self.m - d)).exp();
             self.s *= rescale;
             self.m = d;
         }
-        self.s += w * (-self.alpha * (d - self.m)).exp();
+        let e = w * (-self.alpha * (d - self.m)).exp();
+        self.s += e;
         if self.naive {
             self.naive_s += w * (-self.alpha * d).exp();
         }
+        e
+    }
+
+    /// The sharpness the terms are summed at.
+    #[inline]
+    pub fn alpha(&self) -> f64 {
+        self.alpha
+    }
+
+    /// The shifted sum `S` (before any [`Accumulator::inflate`] it is the sum of the
+    /// added terms, relative to `exp(-alpha m)`).
+    #[inline]
+    pub fn shifted_sum(&self) -> f64 {
+        self.s
     }
 
     /// Multiplies the sums by `factor >= 1`: accounts, from above, for terms that were

@@ -25,6 +25,7 @@
 //! opened; the rest is pushed farthest first, so leaves are still met near to far.
 
 use super::accumulate::{Accumulation, Accumulator};
+use super::reach::Slopes;
 use crate::bvh::Node4;
 use crate::bvh::wide::EMPTY;
 use crate::primitives::{AnySet, Primitive, PrimitiveSet, WeightScale};
@@ -107,18 +108,42 @@ pub struct Sample {
     pub d_seen: f64,
     /// The naive sum underflowed to zero.
     pub underflow: bool,
+    /// Free distance along the direction given to [`evaluate_reach`]: the smooth
+    /// distance stays positive on `x + [0, reach] u` (`eval::reach`); `s` otherwise.
+    pub reach: f64,
     pub stats: EvalStats,
 }
 
 /// Evaluates the smooth distance of the union of `sets` at `x`, with its gradient.
 pub fn evaluate(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
-    evaluate_impl::<true>(sets, x, p)
+    evaluate_impl::<true, false>(sets, x, DVec3::ZERO, p, 0.0)
 }
 
 /// Evaluates the smooth distance only (the returned gradient is zero): what a sphere
 /// tracer needs for its steps, at about half the cost.
 pub fn evaluate_value(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
-    evaluate_impl::<false>(sets, x, p)
+    evaluate_impl::<false, false>(sets, x, DVec3::ZERO, p, 0.0)
+}
+
+/// Evaluates the smooth distance (with the gradient if `grad`) and how far along the
+/// unit direction `u` it provably stays positive (`Sample::reach`, at most `max_len`;
+/// `eval::reach`). Only sets of points have weights that do not vary along the ray: with
+/// any other set, or the naive sum, `reach` is `s`.
+pub fn evaluate_reach(
+    sets: &[&AnySet],
+    x: DVec3,
+    u: DVec3,
+    p: &EvalParams,
+    max_len: f64,
+    grad: bool,
+) -> Sample {
+    let points = sets.iter().all(|s| matches!(s, AnySet::Points(_)));
+    match (points && p.accumulation == Accumulation::Stable, grad) {
+        (true, true) => evaluate_impl::<true, true>(sets, x, u, p, max_len),
+        (true, false) => evaluate_impl::<false, true>(sets, x, u, p, max_len),
+        (false, true) => evaluate(sets, x, p),
+        (false, false) => evaluate_value(sets, x, p),
+    }
 }
 
 /// `ln(N w_max / tol) / alpha` for the `N` primitives of `sets` and their largest
@@ -134,8 +159,15 @@ pub(crate) fn prune_margin(sets: &[&AnySet], p: &EvalParams, tol: f64) -> f64 {
     (total.max(1) as f64 * w_max / tol).ln() / p.alpha
 }
 
-fn evaluate_impl<const GRAD: bool>(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
+fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
+    sets: &[&AnySet],
+    x: DVec3,
+    u: DVec3,
+    p: &EvalParams,
+    max_len: f64,
+) -> Sample {
     let mut acc = Accumulator::new(p.alpha, p.accumulation);
+    let mut slopes = Slopes::default();
     let mut stats = EvalStats::default();
     let scale = |s: &AnySet| WeightScale::new(s.max_adj(), p.alpha, p.max_alpha);
     let prune_margin = if p.prune {
@@ -146,20 +178,35 @@ fn evaluate_impl<const GRAD: bool>(sets: &[&AnySet], x: DVec3, p: &EvalParams) -
     STACK.with_borrow_mut(|stack| {
         for set in sets {
             let sc = scale(set);
-            crate::with_set!(set, s => traverse::<_, GRAD>(s, x, p, &sc, prune_margin, &mut acc, &mut stats, stack));
+            let mut sink = Sink::<GRAD, SLOPE> {
+                acc: &mut acc,
+                slopes: &mut slopes,
+                u,
+            };
+            crate::with_set!(set, s => traverse(s, x, p, &sc, prune_margin, &mut sink, &mut stats, stack));
         }
     });
-    if stats.pruned > 0 {
+    let kept = acc.shifted_sum();
+    let pruned = if stats.pruned > 0 {
         // The pruned subtrees hold less than the tolerance of the final sum (see the
         // module docs): add that bound back so s never exceeds the exact value.
         acc.inflate(1.0 + 2.0 * p.prune_tolerance);
-    }
+        2.0 * p.prune_tolerance * kept
+    } else {
+        0.0
+    };
     let (s, grad, underflow) = acc.finish();
+    let reach = if SLOPE {
+        slopes.free_distance(s, acc.m, p.alpha, pruned, max_len)
+    } else {
+        s
+    };
     Sample {
         s,
         grad,
         d_seen: acc.m,
         underflow,
+        reach,
         stats,
     }
 }
@@ -191,33 +238,75 @@ fn child_distances2(node: &Node4, x: DVec3) -> [f64; 4] {
     d2
 }
 
-/// The far-field term of a subtree with box `min..max` at squared distance `r2 > 0`.
-#[inline]
-fn far_term<const GRAD: bool>(
-    acc: &mut Accumulator,
-    x: DVec3,
-    r2: f64,
-    weight: f64,
-    min: DVec3,
-    max: DVec3,
-) {
-    let r = r2.sqrt();
-    if GRAD {
-        let c = x.clamp(min, max);
-        acc.add(r, weight, (x - c) / r, DVec3::ZERO);
-    } else {
-        acc.add_value(r, weight);
+/// Where a traversal's terms go: the accumulator, with the gradient if `GRAD`, and the
+/// terms' slopes along `u`, binned for the free distance, if `SLOPE` (`eval::reach`).
+struct Sink<'a, const GRAD: bool, const SLOPE: bool> {
+    acc: &'a mut Accumulator,
+    slopes: &'a mut Slopes,
+    u: DVec3,
+}
+
+impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
+    /// The slope bins follow the accumulator's shift when a term lowers it.
+    #[inline]
+    fn add_slope(&mut self, m_before: f64, e: f64, a: f64) {
+        if self.acc.m < m_before {
+            let alpha = self.acc.alpha();
+            self.slopes
+                .rescale((-alpha * (m_before - self.acc.m)).exp());
+        }
+        self.slopes.add(e, a);
+    }
+
+    /// The far-field term of a subtree with box `min..max` at squared distance `r2 > 0`.
+    #[inline]
+    fn far(&mut self, x: DVec3, r2: f64, weight: f64, min: DVec3, max: DVec3) {
+        let r = r2.sqrt();
+        let m = self.acc.m;
+        if GRAD {
+            let dir = (x - x.clamp(min, max)) / r;
+            let e = self.acc.add(r, weight, dir, DVec3::ZERO);
+            if SLOPE {
+                self.add_slope(m, e, dir.dot(self.u));
+            }
+        } else if SLOPE {
+            let a = (x - x.clamp(min, max)).dot(self.u) / r;
+            let e = self.acc.add_value(r, weight);
+            self.add_slope(m, e, a);
+        } else {
+            self.acc.add_value(r, weight);
+        }
+    }
+
+    /// A primitive's exact term.
+    #[inline]
+    fn exact<P: Primitive>(&mut self, prim: &P, x: DVec3, scale: &WeightScale) {
+        let m = self.acc.m;
+        if GRAD {
+            let t = prim.term(x, scale);
+            let e = self.acc.add(t.d, t.w, t.dir, t.grad_w);
+            if SLOPE {
+                self.add_slope(m, e, t.dir.dot(self.u));
+            }
+        } else if SLOPE {
+            let (d, w, a) = prim.value_slope(x, self.u, scale);
+            let e = self.acc.add_value(d, w);
+            self.add_slope(m, e, a);
+        } else {
+            let (d, w) = prim.value(x, scale);
+            self.acc.add_value(d, w);
+        }
     }
 }
 
 #[allow(clippy::too_many_arguments)]
-fn traverse<P: Primitive, const GRAD: bool>(
+fn traverse<P: Primitive, const GRAD: bool, const SLOPE: bool>(
     set: &PrimitiveSet<P>,
     x: DVec3,
     p: &EvalParams,
     scale: &WeightScale,
     prune_margin: f64,
-    acc: &mut Accumulator,
+    sink: &mut Sink<GRAD, SLOPE>,
     stats: &mut EvalStats,
     stack: &mut Vec<Entry>,
 ) {
@@ -236,7 +325,7 @@ fn traverse<P: Primitive, const GRAD: bool>(
     );
     let r2 = (x - x.clamp(rmin, rmax)).length_squared();
     if root.count == 0 && p.beta > 0.0 && (root.diam2 as f64) < beta2 * r2 {
-        far_term::<GRAD>(acc, x, r2, root.size as f64 * w_ff, rmin, rmax);
+        sink.far(x, r2, root.size as f64 * w_ff, rmin, rmax);
         stats.far += 1;
         return;
     }
@@ -247,6 +336,7 @@ fn traverse<P: Primitive, const GRAD: bool>(
     stack.push((root.child, root.count, r2));
     while let Some((i, count, r2)) = stack.pop() {
         stats.nodes += 1;
+        let acc = &sink.acc;
         let reach = acc.m + (prune_margin - acc.ln_sum_lower_bound() * inv_alpha);
         let reach2 = reach * reach;
         if r2 > reach2 {
@@ -256,13 +346,7 @@ fn traverse<P: Primitive, const GRAD: bool>(
         if count > 0 {
             let first = i as usize;
             for prim in &set.prims[first..first + count as usize] {
-                if GRAD {
-                    let t = prim.term(x, scale);
-                    acc.add(t.d, t.w, t.dir, t.grad_w);
-                } else {
-                    let (d, w) = prim.value(x, scale);
-                    acc.add_value(d, w);
-                }
+                sink.exact(prim, x, scale);
             }
             stats.exact += count;
             continue;
@@ -301,7 +385,7 @@ fn traverse<P: Primitive, const GRAD: bool>(
             }
             if p.beta > 0.0 && (node.mid_diam2[j] as f64) < beta2 * r2m {
                 let (min, max) = slot_box(near);
-                far_term::<GRAD>(acc, x, r2m, node.mid_size[j] as f64 * w_ff, min, max);
+                sink.far(x, r2m, node.mid_size[j] as f64 * w_ff, min, max);
                 stats.far += 1;
                 continue;
             }
@@ -316,7 +400,7 @@ fn traverse<P: Primitive, const GRAD: bool>(
                 }
                 if c == 0 && p.beta > 0.0 && (node.diam2[k] as f64) < beta2 * d2[k] {
                     let (min, max) = slot_box(k);
-                    far_term::<GRAD>(acc, x, d2[k], node.size[k] as f64 * w_ff, min, max);
+                    sink.far(x, d2[k], node.size[k] as f64 * w_ff, min, max);
                     stats.far += 1;
                     continue;
                 }

@@ -31,6 +31,18 @@ pub trait Primitive: Copy + Send + Sync + 'static {
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term;
     /// `(d, w)` only: what a value-only evaluation (sphere-tracing steps) needs.
     fn value(&self, x: DVec3, scale: &WeightScale) -> (f64, f64);
+    /// `(d, w, a)` with `a = u . (x - c) / d` the slope of the distance along unit `u`
+    /// (0 on the primitive): for the free distance of `eval::reach`.
+    #[inline]
+    fn value_slope(&self, x: DVec3, u: DVec3, scale: &WeightScale) -> (f64, f64, f64) {
+        let (d, w) = self.value(x, scale);
+        let a = if d > 0.0 {
+            (x - self.closest_point(x)).dot(u) / d
+        } else {
+            0.0
+        };
+        (d, w, a)
+    }
 }
 
 #[inline]
@@ -60,6 +72,12 @@ impl Primitive for Point {
     #[inline]
     fn value(&self, x: DVec3, _scale: &WeightScale) -> (f64, f64) {
         ((x - self.p.as_dvec3()).length(), 1.0)
+    }
+    #[inline]
+    fn value_slope(&self, x: DVec3, u: DVec3, _scale: &WeightScale) -> (f64, f64, f64) {
+        let v = x - self.p.as_dvec3();
+        let d = v.length();
+        (d, 1.0, if d > 0.0 { v.dot(u) / d } else { 0.0 })
     }
     #[inline]
     fn term(&self, x: DVec3, _scale: &WeightScale) -> Term {

@@ -61,7 +61,9 @@ impl TraceObject {
     /// replaced (the naive mode's falloff), at opening parameter `beta` (the tracer's
     /// bound steps take a coarser one, a lower bound of the scene's sum; its hit
     /// decisions a finer one) and the pruning tolerance possibly raised (a lower bound
-    /// too, see `eval::smooth`), with the gradient if `grad`.
+    /// too, see `eval::smooth`), with the gradient if `grad`, and with the free distance
+    /// along a ray `(u, max_len)` if `along` is given (`eval::reach`).
+    #[allow(clippy::too_many_arguments)]
     pub fn evaluate(
         &self,
         sets: &[&AnySet],
@@ -70,12 +72,15 @@ impl TraceObject {
         beta: f64,
         prune_tolerance: f64,
         grad: bool,
+        along: Option<(DVec3, f64)>,
     ) -> Sample {
         let mut p = self.params;
         p.alpha = alpha;
         p.beta = beta;
         p.prune_tolerance = p.prune_tolerance.max(prune_tolerance);
-        if grad {
+        if let Some((u, max_len)) = along {
+            eval::evaluate_reach(sets, x, u, &p, max_len, grad)
+        } else if grad {
             eval::evaluate(sets, x, &p)
         } else {
             eval::evaluate_value(sets, x, &p)

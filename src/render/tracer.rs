@@ -69,6 +69,9 @@ pub struct TracerOptions {
     /// Hits on objects with edges or triangles are decided at this share of the scene's
     /// beta (module docs, item 9); 1 decides them at the scene's beta (the paper's).
     pub hit_beta_scale: f64,
+    /// Steps by the free distance along the ray from the terms' slopes (`eval::reach`;
+    /// objects of points only), at least the plain step.
+    pub reach_steps: bool,
     /// Clip rays to the grown scene box (misses outside it cost no evaluation). Off,
     /// rays start at the camera's smooth distance and march to the box's far side, as
     /// in the paper's renderer.
@@ -96,6 +99,7 @@ impl TracerOptions {
             cone: true,
             relax: true,
             hit_beta_scale: 0.6,
+            reach_steps: true,
             clip: true,
             backtrack: Backtrack::Illinois,
         }
@@ -110,6 +114,7 @@ impl TracerOptions {
             cone: false,
             relax: false,
             hit_beta_scale: 1.0,
+            reach_steps: false,
             clip: false,
             backtrack: Backtrack::FixedStep,
             ..TracerOptions::new(epsilon, max_steps)
@@ -167,6 +172,8 @@ struct FieldSample {
     object: usize,
     /// Gradient of the winning object's smooth distance, when it was asked for.
     grad: Option<DVec3>,
+    /// Free distance along the ray (`eval::reach`; `s` when not asked for).
+    reach: f64,
 }
 
 /// What an evaluation is for: a bound step at a coarser beta, or a full-accuracy value
@@ -213,7 +220,11 @@ impl<'a> Tracer<'a> {
             .iter()
             .map(|o| {
                 let points_only = o.sets.iter().all(|s| matches!(s, AnySet::Points(_)));
-                let scale = if points_only { 1.0 } else { options.hit_beta_scale };
+                let scale = if points_only {
+                    1.0
+                } else {
+                    options.hit_beta_scale
+                };
                 o.params.beta * scale.clamp(0.0, 1.0)
             })
             .collect();
@@ -240,7 +251,7 @@ impl<'a> Tracer<'a> {
 
     /// The scene field at `x` (the minimum over objects) and the object attaining it.
     pub fn field(&self, x: DVec3, stats: &mut RayStats) -> (f64, usize) {
-        let f = self.sample(x, stats, Want::Value, false);
+        let f = self.sample(x, stats, Want::Value, false, None);
         (f.s, f.object)
     }
 
@@ -248,7 +259,7 @@ impl<'a> Tracer<'a> {
     /// parameter `beta` (at least the scene's): cheaper than [`Tracer::field`] for a
     /// larger `beta`, counted as a bound step.
     pub fn bound(&self, x: DVec3, beta: f64, stats: &mut RayStats) -> f64 {
-        self.sample(x, stats, Want::Bound(beta), false).s
+        self.sample(x, stats, Want::Bound(beta), false, None).s
     }
 
     /// The gradient of object `k`'s smooth distance at `x` (one evaluation, at the hit
@@ -257,8 +268,15 @@ impl<'a> Tracer<'a> {
         let obj = &self.objects[k];
         let mut alpha = obj.params.alpha;
         loop {
-            let sample =
-                obj.evaluate(&self.sets[k], x, alpha, self.hit_beta[k], self.tolerance[k], true);
+            let sample = obj.evaluate(
+                &self.sets[k],
+                x,
+                alpha,
+                self.hit_beta[k],
+                self.tolerance[k],
+                true,
+                None,
+            );
             stats.evals += 1;
             stats.eval.add(&sample.stats);
             if sample.s.is_finite() || alpha <= 1e-300 {
@@ -270,12 +288,22 @@ impl<'a> Tracer<'a> {
     }
 
     /// The scene field at `x` for `want`; full evaluations at the hit beta if `accurate`.
-    fn sample(&self, x: DVec3, stats: &mut RayStats, want: Want, accurate: bool) -> FieldSample {
+    fn sample(
+        &self,
+        x: DVec3,
+        stats: &mut RayStats,
+        want: Want,
+        accurate: bool,
+        along: Option<(DVec3, f64)>,
+    ) -> FieldSample {
         let mut best = FieldSample {
             s: f64::INFINITY,
             object: 0,
             grad: None,
+            reach: f64::INFINITY,
         };
+        // With several objects a step is the smallest value (no free distance).
+        let along = along.filter(|_| self.objects.len() == 1 && !matches!(want, Want::Bound(_)));
         let (coarse, grad) = match want {
             Want::Bound(beta) => (Some(beta), false),
             Want::Value => (None, false),
@@ -292,7 +320,15 @@ impl<'a> Tracer<'a> {
                     None if accurate => self.hit_beta[k],
                     None => obj.params.beta,
                 };
-                let sample = obj.evaluate(&self.sets[k], x, alpha, beta, self.tolerance[k], grad);
+                let sample = obj.evaluate(
+                    &self.sets[k],
+                    x,
+                    alpha,
+                    beta,
+                    self.tolerance[k],
+                    grad,
+                    along,
+                );
                 if coarse.is_some() {
                     stats.coarse_evals += 1;
                     stats.coarse_leaves += sample.stats.leaves();
@@ -315,6 +351,11 @@ impl<'a> Tracer<'a> {
                     object: k,
                     // A falloff's gradient is that of a smaller alpha: recomputed at the hit.
                     grad: (grad && alpha == obj.params.alpha).then_some(sample.grad),
+                    reach: if alpha == obj.params.alpha {
+                        sample.reach.max(sample.s)
+                    } else {
+                        sample.s
+                    },
                 };
             }
         }
@@ -354,9 +395,9 @@ impl<'a> Tracer<'a> {
             (0.0, (o - c).length() + 0.5 * (self.max - self.min).length())
         };
         let mut t = t_enter.max(t_start);
-        // The last certified sample: (t, a lower bound of the field there). Everything
-        // up to `t + s` is free of the surface.
-        let mut prev: Option<(f64, f64)> = None;
+        // The last certified sample: (t, a lower bound of the field there, the free
+        // distance from it). Everything up to `t + free` is free of the surface.
+        let mut prev: Option<(f64, f64, f64)> = None;
         let mut stepper = Stepper::new(self.options.relax);
         let coarse = (self.options.coarse_beta > 0.0).then_some(self.options.coarse_beta);
         let tau = self.options.coarse_threshold * eps;
@@ -376,15 +417,15 @@ impl<'a> Tracer<'a> {
             }
             let x = o + t * d;
             if let (Some(beta), false) = (coarse, near) {
-                let c = self.sample(x, &mut stats, Want::Bound(beta), false);
+                let c = self.sample(x, &mut stats, Want::Bound(beta), false, None);
                 if c.s > tau {
                     if let Some(back) = stepper.uncovered(prev, t, c.s) {
                         stats.rejected_steps += 1;
                         t = back;
                         continue;
                     }
-                    let step = stepper.step(prev, t, c.s, Kind::Bound);
-                    prev = Some((t, c.s));
+                    let step = stepper.step(prev, t, c.s, c.s, Kind::Bound);
+                    prev = Some((t, c.s, c.s));
                     t += step;
                     continue;
                 }
@@ -395,7 +436,8 @@ impl<'a> Tracer<'a> {
                 }
             }
             accurate |= refine && want == Want::Gradient;
-            let mut f = self.sample(x, &mut stats, want, accurate);
+            let along = self.options.reach_steps.then_some((d, t_max - t));
+            let mut f = self.sample(x, &mut stats, want, accurate, along);
             if let Some(back) = stepper.uncovered(prev, t, f.s) {
                 // An over-relaxed step left a gap: go back to the plain step's end.
                 stats.rejected_steps += 1;
@@ -408,7 +450,7 @@ impl<'a> Tracer<'a> {
                 // (a lower bound too, so the step that got here stays safe).
                 accurate = true;
                 stats.refinements += 1;
-                f = self.sample(x, &mut stats, Want::Gradient, true);
+                f = self.sample(x, &mut stats, Want::Gradient, true, along);
             }
             near = f.s < 2.0 * tau;
             if f.s.abs() <= eps {
@@ -423,13 +465,13 @@ impl<'a> Tracer<'a> {
                     Some(_) if self.options.backtrack == Backtrack::FixedStep => {
                         self.step_back(o, d, t, &mut stats)
                     }
-                    Some((tp, sp)) => self.backtrack(o, d, (tp, sp), (t, f.s), &mut stats),
+                    Some((tp, sp, _)) => self.backtrack(o, d, (tp, sp), (t, f.s), &mut stats),
                     // Negative at the first sample: the ray starts inside the band.
                     None => Some(self.hit(o, d, t, &f, &mut stats)),
                 };
                 return RayResult { hit, stats };
             }
-            let step = stepper.step(prev, t, f.s, Kind::Full);
+            let step = stepper.step(prev, t, f.s, f.reach, Kind::Full);
             // The value at the next sample, if the field keeps its slope along the ray.
             let predicted = f.s - stepper.slope * step;
             want = if predicted <= eps || f.s <= 2.0 * eps {
@@ -437,7 +479,7 @@ impl<'a> Tracer<'a> {
             } else {
                 Want::Value
             };
-            prev = Some((t, f.s));
+            prev = Some((t, f.s, f.reach));
             t += step;
         }
         RayResult { hit: None, stats }
@@ -464,7 +506,7 @@ impl<'a> Tracer<'a> {
         while stats.evals + stats.coarse_evals < self.options.max_steps {
             t -= eps;
             let before = stats.evals;
-            let f = self.sample(o + t * d, stats, Want::Value, true);
+            let f = self.sample(o + t * d, stats, Want::Value, true, None);
             stats.backtracks += stats.evals - before;
             if f.s >= -eps {
                 return Some(self.hit(o, d, t, &f, stats));
@@ -496,7 +538,7 @@ impl<'a> Tracer<'a> {
                 t = 0.5 * (lo + hi);
             }
             let before = stats.evals;
-            let f = self.sample(o + t * d, stats, Want::Value, true);
+            let f = self.sample(o + t * d, stats, Want::Value, true, None);
             stats.backtracks += stats.evals - before;
             if f.s.abs() <= eps || hi - lo <= eps {
                 return Some(self.hit(o, d, t, &f, stats));
@@ -567,8 +609,8 @@ impl Stepper {
 
     /// If the last step was relaxed and the sample at `t` (lower bound `s`) does not
     /// close the gap, the plain step's end to go back to (the slope is forgotten).
-    fn uncovered(&mut self, prev: Option<(f64, f64)>, t: f64, s: f64) -> Option<f64> {
-        let (tp, sp) = prev?;
+    fn uncovered(&mut self, prev: Option<(f64, f64, f64)>, t: f64, s: f64) -> Option<f64> {
+        let (tp, _, sp) = prev?;
         if !self.relaxed || sp + s >= t - tp {
             return None;
         }
@@ -579,7 +621,15 @@ impl Stepper {
     }
 
     /// The step to take from `t`, where the field is at least `s > 0`.
-    fn step(&mut self, prev: Option<(f64, f64)>, t: f64, s: f64, kind: Kind) -> f64 {
+    /// `reach >= s` is the sample's certified free distance (`s` for a plain sample).
+    fn step(
+        &mut self,
+        prev: Option<(f64, f64, f64)>,
+        t: f64,
+        s: f64,
+        reach: f64,
+        kind: Kind,
+    ) -> f64 {
         if let (Some((tl, sl, kl)), Some(_)) = (self.last, prev)
             && kl == kind
             && t > tl
@@ -594,8 +644,9 @@ impl Stepper {
         } else {
             1.0
         };
-        self.relaxed = factor > 1.0;
-        factor * s
+        let relaxed = factor * s;
+        self.relaxed = relaxed > reach;
+        relaxed.max(reach)
     }
 }
 
@@ -619,8 +670,8 @@ mod tests {
             if s <= eps {
                 return (t, n);
             }
-            let step = stepper.step(prev, t, s, Kind::Full);
-            prev = Some((t, s));
+            let step = stepper.step(prev, t, s, s, Kind::Full);
+            prev = Some((t, s, s));
             t += step;
         }
     }
