@@ -42,10 +42,19 @@ impl<P: Primitive> PrimitiveSet<P> {
     /// Builds the BVH over `prims` and reorders them into leaf order.
     pub fn new(prims: Vec<P>, max_adj: f64, options: BuildOptions, prim_seconds: f64) -> Self {
         let t = Instant::now();
-        let bounds: Vec<Aabb> = prims.par_iter().map(|p| p.bounds()).collect();
         let centroids: Vec<_> = prims.par_iter().map(|p| p.centroid()).collect();
-        let mut bvh = bvh::build_binary(&bounds, &centroids, options);
-        drop((bounds, centroids));
+        // Points (every box is its centroid) build without a copy of their boxes.
+        let points = prims.par_iter().zip(&centroids).all(|(p, &c)| {
+            let b = p.bounds();
+            b.min == c && b.max == c
+        });
+        let mut bvh = if points {
+            bvh::build_binary_points(&centroids, options)
+        } else {
+            let bounds: Vec<Aabb> = prims.par_iter().map(|p| p.bounds()).collect();
+            bvh::build_binary(&bounds, &centroids, options)
+        };
+        drop(centroids);
         let sorted: Vec<P> = bvh.order.par_iter().map(|&i| prims[i as usize]).collect();
         drop(prims);
         bvh.make_wide();
