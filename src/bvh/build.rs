@@ -1,10 +1,17 @@
-//! Binned surface-area-heuristic build (Wald 2007), parallel with rayon. Each level makes
-//! one pass over its primitives: the binning pass also gathers, per bin, the primitive
-//! bounds and the centroid bounds, from which both children's boxes follow, so no extra
-//! bounds passes are needed. Large ranges bin in parallel and build their halves in
-//! parallel. Degenerate inputs (all centroids equal, e.g. duplicate points) fall back to
-//! splitting at the middle index, so the build always ends with leaves of at most
-//! `leaf_size` primitives.
+//! Binned surface-area-heuristic build (Wald 2007), parallel with rayon (SPEC 6).
+//!
+//! The build works on 16-byte records (centroid + input index, [`Item`]) that the
+//! partitions move, so every pass reads memory in order; `order` is read off the records
+//! at the end. Each level makes two passes over its range: binning (`super::bins`),
+//! which also gathers per bin the primitive bounds and the centroid bounds, from which
+//! both children's boxes follow, and a branch-free partition. Ranges of at most
+//! [`SWEEP_MAX`] primitives are split by sorting and sweeping all positions
+//! (`super::sweep`) instead, which is cheaper there than clearing and scanning 16 bins.
+//! Large ranges bin in parallel and build their halves in parallel; the serial pieces
+//! are laid out depth-first at the end, in parallel. Degenerate inputs (all centroids
+//! equal, e.g. duplicate points) fall back to splitting at the middle index, so the build
+//! always ends with leaves of at most `leaf_size` primitives. Points (each box its
+//! centroid) are built without a copy of their boxes.
 
 use super::bins::{self, BINS, Binning, Bins, Item};
 use super::sweep::{SWEEP_MAX, half_area, sweep_split};
@@ -42,7 +49,7 @@ pub(super) struct Input<'a> {
 
 impl Input<'_> {
     #[inline]
-    fn bounds_of(&self, item: &Item) -> Aabb {
+    pub fn bounds_of(&self, item: &Item) -> Aabb {
         match self.bounds {
             Some(b) => b[item.index as usize],
             None => {
@@ -97,28 +104,41 @@ pub fn build_binary(bounds: &[Aabb], centroids: &[Vec3], options: BuildOptions) 
         .par_iter()
         .zip(centroids.par_iter())
         .all(|(b, &c)| b.min == c && b.max == c);
-    build_items(centroids, (!points).then_some(bounds), options)
+    build_with(
+        centroids.len(),
+        |i| centroids[i],
+        (!points).then_some(bounds),
+        options,
+    )
 }
 
 /// [`build_binary`] for points (every primitive's box is its centroid): the same tree,
 /// without the boxes in memory.
 pub fn build_binary_points(points: &[Vec3], options: BuildOptions) -> Bvh {
-    build_items(points, None, options)
+    build_with(points.len(), |i| points[i], None, options)
 }
 
-fn build_items(centroids: &[Vec3], bounds: Option<&[Aabb]>, options: BuildOptions) -> Bvh {
-    if centroids.is_empty() {
+/// [`build_binary`] over `n` primitives whose centroids are `centroid(i)`, with their
+/// boxes in `bounds`, or `None` when every box is its centroid (points): callers that
+/// hold their primitives need no copy of the centroids.
+pub fn build_with(
+    n: usize,
+    centroid: impl Fn(usize) -> Vec3 + Sync,
+    bounds: Option<&[Aabb]>,
+    options: BuildOptions,
+) -> Bvh {
+    assert!(bounds.is_none_or(|b| b.len() == n));
+    if n == 0 {
         return Bvh::default();
     }
     let input = Input {
         bounds,
         leaf_size: options.leaf_size.max(1),
     };
-    let mut items: Vec<Item> = centroids
-        .par_iter()
-        .enumerate()
-        .map(|(i, c)| Item {
-            c: c.to_array(),
+    let mut items: Vec<Item> = (0..n)
+        .into_par_iter()
+        .map(|i| Item {
+            c: centroid(i).to_array(),
             index: i as u32,
         })
         .collect();
@@ -127,8 +147,7 @@ fn build_items(centroids: &[Vec3], bounds: Option<&[Aabb]>, options: BuildOption
         .map(|chunk| range_bounds(&input, chunk))
         .reduce(|| RangeBounds::EMPTY, RangeBounds::union);
     let built = build_range(&input, &mut items, 0, rb);
-    let mut nodes = Vec::with_capacity(built.len());
-    built.flatten(&mut nodes);
+    let nodes = built.flatten();
     let order = items.par_iter().map(|it| it.index).collect();
     Bvh {
         nodes,
@@ -138,7 +157,7 @@ fn build_items(centroids: &[Vec3], bounds: Option<&[Aabb]>, options: BuildOption
 }
 
 /// Bounds of the primitives and of the centroids of `items`.
-fn range_bounds(input: &Input, items: &[Item]) -> RangeBounds {
+pub(super) fn range_bounds(input: &Input, items: &[Item]) -> RangeBounds {
     items
         .iter()
         .fold(RangeBounds::EMPTY, |acc, it| acc.grow(input, it))
@@ -160,24 +179,33 @@ impl Built {
         }
     }
 
-    /// Appends the subtree depth-first to `out`, fixing the right-child indices.
-    fn flatten(self, out: &mut Vec<Node>) {
+    /// Lays the subtree out depth-first, its pieces copied in parallel.
+    fn flatten(self) -> Vec<Node> {
+        let placeholder = make_node(Aabb::EMPTY, 0, 0, 0);
+        let mut out = Vec::with_capacity(self.len());
+        out.par_extend(rayon::iter::repeat_n(placeholder, self.len()));
+        self.write(&mut out, 0);
+        out
+    }
+
+    /// Writes the subtree depth-first into `out` (exactly [`Built::len`] nodes), whose
+    /// first node has index `base` in the whole array, fixing the right-child indices.
+    fn write(self, out: &mut [Node], base: u32) {
         match self {
             Built::Serial(v) => {
-                let base = out.len() as u32;
-                out.extend(v.into_iter().map(|mut n| {
+                for (o, mut n) in out.iter_mut().zip(v) {
                     if !n.is_leaf() {
                         n.index += base;
                     }
-                    n
-                }));
+                    *o = n;
+                }
             }
-            Built::Split(node, l, r) => {
-                let here = out.len();
-                out.push(node);
-                l.flatten(out);
-                out[here].index = out.len() as u32;
-                r.flatten(out);
+            Built::Split(mut node, l, r) => {
+                let (head, rest) = out.split_at_mut(1);
+                let (left, right) = rest.split_at_mut(l.len());
+                node.index = base + 1 + left.len() as u32;
+                head[0] = node;
+                rayon::join(|| l.write(left, base + 1), || r.write(right, node.index));
             }
         }
     }
@@ -187,7 +215,8 @@ impl Built {
 /// parallel above `PARALLEL_MIN` items.
 fn build_range(input: &Input, items: &mut [Item], offset: usize, rb: RangeBounds) -> Built {
     if items.len() < PARALLEL_MIN {
-        let mut nodes = Vec::with_capacity(2 * items.len() / input.leaf_size + 1);
+        // At most 2n - 1 nodes; only the pages written are ever touched.
+        let mut nodes = Vec::with_capacity(2 * items.len() - 1);
         build_serial(input, items, offset, rb, &mut nodes);
         return Built::Serial(nodes);
     }

@@ -12,7 +12,7 @@ mod sweep;
 mod validate;
 pub mod wide;
 
-pub use build::{BuildOptions, build, build_binary, build_binary_points};
+pub use build::{BuildOptions, build, build_binary, build_binary_points, build_with};
 pub use validate::validate;
 pub use wide::{Node4, Root};
 

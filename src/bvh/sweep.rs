@@ -8,7 +8,7 @@
 //! axis instead of the best bin boundary.
 
 use super::bins::Item;
-use super::build::{Input, RangeBounds};
+use super::build::{Input, RangeBounds, range_bounds};
 use crate::mesh::Aabb;
 
 /// Ranges up to this size are split by the sweep.
@@ -24,18 +24,20 @@ pub(super) fn sweep_split(
 ) -> (usize, RangeBounds, RangeBounds) {
     let n = items.len();
     debug_assert!((2..=SWEEP_MAX).contains(&n));
-    items.sort_unstable_by(|a, b| a.c[axis].total_cmp(&b.c[axis]));
-    // Bounds of the suffixes items[i..], then the best split from the left.
-    let mut suffix = [RangeBounds::EMPTY; SWEEP_MAX + 1];
-    for i in (0..n).rev() {
-        suffix[i] = suffix[i + 1].grow(input, &items[i]);
-    }
+    sort_along(items, axis);
+    // SAH cost of every position: the suffixes' parts from the right, then the
+    // prefixes' from the left (only costs are kept; the two halves' bounds are
+    // gathered once the position is chosen).
     let mut cost = [0f32; SWEEP_MAX];
-    let mut prefix = RangeBounds::EMPTY;
+    let mut acc = Aabb::EMPTY;
+    for i in (1..n).rev() {
+        acc = acc.union(input.bounds_of(&items[i]));
+        cost[i] = half_area(&acc) * (n - i) as f32;
+    }
+    let mut acc = Aabb::EMPTY;
     for i in 1..n {
-        prefix = prefix.grow(input, &items[i - 1]);
-        cost[i] =
-            half_area(&prefix.prims) * i as f32 + half_area(&suffix[i].prims) * (n - i) as f32;
+        acc = acc.union(input.bounds_of(&items[i - 1]));
+        cost[i] += half_area(&acc) * i as f32;
     }
     // Ties (coincident points cost 0 everywhere) go to the middle.
     let mut best = n / 2;
@@ -44,10 +46,25 @@ pub(super) fn sweep_split(
             best = i;
         }
     }
-    let left = items[..best]
-        .iter()
-        .fold(RangeBounds::EMPTY, |acc, it| acc.grow(input, it));
-    (best, left, suffix[best])
+    (
+        best,
+        range_bounds(input, &items[..best]),
+        range_bounds(input, &items[best..]),
+    )
+}
+
+/// Insertion sort by centroid along `axis` (few items; NaN keys stay where they are).
+fn sort_along(items: &mut [Item], axis: usize) {
+    for i in 1..items.len() {
+        let x = items[i];
+        let key = x.c[axis];
+        let mut j = i;
+        while j > 0 && items[j - 1].c[axis] > key {
+            items[j] = items[j - 1];
+            j -= 1;
+        }
+        items[j] = x;
+    }
 }
 
 /// Half the surface area of a box (0 for an empty box).

@@ -42,22 +42,31 @@ impl<P: Primitive> PrimitiveSet<P> {
     /// Builds the BVH over `prims` and reorders them into leaf order.
     pub fn new(prims: Vec<P>, max_adj: f64, options: BuildOptions, prim_seconds: f64) -> Self {
         let t = Instant::now();
-        let centroids: Vec<_> = prims.par_iter().map(|p| p.centroid()).collect();
         // Points (every box is its centroid) build without a copy of their boxes.
-        let points = prims.par_iter().zip(&centroids).all(|(p, &c)| {
-            let b = p.bounds();
+        let points = prims.par_iter().all(|p| {
+            let (b, c) = (p.bounds(), p.centroid());
             b.min == c && b.max == c
         });
+        let centroid = |i: usize| prims[i].centroid();
         let mut bvh = if points {
-            bvh::build_binary_points(&centroids, options)
+            bvh::build_with(prims.len(), centroid, None, options)
         } else {
             let bounds: Vec<Aabb> = prims.par_iter().map(|p| p.bounds()).collect();
-            bvh::build_binary(&bounds, &centroids, options)
+            bvh::build_with(prims.len(), centroid, Some(&bounds), options)
         };
-        drop(centroids);
-        let sorted: Vec<P> = bvh.order.par_iter().map(|&i| prims[i as usize]).collect();
+        // The reordering and the wide form (which reads only the nodes) in parallel.
+        let order = std::mem::take(&mut bvh.order);
+        let (sorted, ()) = rayon::join(
+            || {
+                order
+                    .par_iter()
+                    .map(|&i| prims[i as usize])
+                    .collect::<Vec<P>>()
+            },
+            || bvh.make_wide(),
+        );
+        bvh.order = order;
         drop(prims);
-        bvh.make_wide();
         let bounds = bvh
             .nodes
             .first()
