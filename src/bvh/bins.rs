@@ -143,6 +143,16 @@ fn bin_points_lanes<const LANES: usize>(items: &[Item], binning: Binning) -> Bin
     out
 }
 
+/// A fixed-seed generator of floats in [0, 1) for the build's tests.
+#[cfg(test)]
+pub(super) fn test_random(seed: u32) -> impl FnMut() -> f32 {
+    let mut s = seed;
+    move || {
+        s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (s >> 8) as f32 / (1 << 24) as f32
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -150,11 +160,7 @@ mod tests {
     /// Counts and boxes per bin computed the plain way, from each point's bin index.
     #[test]
     fn points_binning_matches_a_direct_count() {
-        let mut s = 5u32;
-        let mut r = move || {
-            s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (s >> 8) as f32 / (1 << 24) as f32
-        };
+        let mut r = test_random(5);
         for n in [1usize, 3, 63, 64, 67, 1000] {
             // Runs of equal points, as in a scan, and points outside the binned range.
             let items: Vec<Item> = (0..n)

@@ -371,16 +371,8 @@ fn median_split(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bvh::bins::test_random as random;
     use crate::bvh::validate;
-
-    /// A fixed-seed generator of floats in [0, 1).
-    fn random(seed: u32) -> impl FnMut() -> f32 {
-        let mut s = seed;
-        move || {
-            s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (s >> 8) as f32 / (1 << 24) as f32
-        }
-    }
 
     /// Point sets of every shape the build meets: uniform, on a line (two empty extents),
     /// clustered with many exact duplicates, all coincident.

@@ -85,11 +85,7 @@ mod tests {
     /// computed here from scratch for every position.
     #[test]
     fn sweep_finds_the_cheapest_position() {
-        let mut s = 9u32;
-        let mut r = move || {
-            s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (s >> 8) as f32 / (1 << 24) as f32
-        };
+        let mut r = super::super::bins::test_random(9);
         let input = Input {
             bounds: None,
             leaf_size: 1,
