@@ -1,11 +1,20 @@
-//! Binned surface-area-heuristic build (Wald 2007), parallel with rayon. Each level makes
-//! one pass over its primitives: the binning pass also gathers, per bin, the primitive
-//! bounds and the centroid bounds, from which both children's boxes follow, so no extra
-//! bounds passes are needed. Large ranges bin in parallel and build their halves in
-//! parallel. Degenerate inputs (all centroids equal, e.g. duplicate points) fall back to
-//! splitting at the middle index, so the build always ends with leaves of at most
-//! `leaf_size` primitives.
+//! Binned surface-area-heuristic build (Wald 2007), parallel with rayon (SPEC 6).
+//!
+//! The build works on 16-byte records (centroid + input index, [`Item`]) that the
+//! partitions move, so every pass reads memory in order; `order` is read off the records
+//! at the end. Each level makes two passes over its range: binning (`super::bins`),
+//! which also gathers per bin the primitive bounds and the centroid bounds, from which
+//! both children's boxes follow, and a branch-free partition. Ranges of at most
+//! [`SWEEP_MAX`] primitives are split by sorting and sweeping all positions
+//! (`super::sweep`) instead, which is cheaper there than clearing and scanning 16 bins.
+//! Large ranges bin in parallel and build their halves in parallel; the serial pieces
+//! are laid out depth-first at the end, in parallel. Degenerate inputs (all centroids
+//! equal, e.g. duplicate points) fall back to splitting at the middle index, so the build
+//! always ends with leaves of at most `leaf_size` primitives. Points (each box its
+//! centroid) are built without a copy of their boxes.
 
+use super::bins::{self, BINS, Binning, Bins, Item};
+use super::sweep::{SWEEP_MAX, half_area, sweep_split};
 use super::{Bvh, Node};
 use crate::mesh::Aabb;
 use glam::Vec3;
@@ -24,25 +33,60 @@ impl Default for BuildOptions {
     }
 }
 
-const BINS: usize = 16;
 /// Ranges larger than this build their two halves in parallel.
 const PARALLEL_MIN: usize = 16 * 1024;
 /// Ranges larger than this are binned in parallel chunks.
 const PARALLEL_BINNING_MIN: usize = 256 * 1024;
+/// Chunk of items per parallel task in the passes over large ranges.
+const CHUNK: usize = 64 * 1024;
 
-struct Input<'a> {
-    bounds: &'a [Aabb],
-    centroids: &'a [Vec3],
-    leaf_size: usize,
-    /// Every primitive's box is its centroid (points): binning skips the boxes.
-    points: bool,
+pub(super) struct Input<'a> {
+    /// Primitive boxes by input index; `None` when every box is its centroid (points),
+    /// then binning reads the centroids only.
+    pub bounds: Option<&'a [Aabb]>,
+    pub leaf_size: usize,
+}
+
+impl Input<'_> {
+    #[inline]
+    pub fn bounds_of(&self, item: &Item) -> Aabb {
+        match self.bounds {
+            Some(b) => b[item.index as usize],
+            None => {
+                let c = Vec3::from_array(item.c);
+                Aabb { min: c, max: c }
+            }
+        }
+    }
 }
 
 /// Bounds of a range: of its primitives and of their centroids.
 #[derive(Clone, Copy)]
-struct RangeBounds {
-    prims: Aabb,
-    centroids: Aabb,
+pub(super) struct RangeBounds {
+    pub prims: Aabb,
+    pub centroids: Aabb,
+}
+
+impl RangeBounds {
+    pub const EMPTY: RangeBounds = RangeBounds {
+        prims: Aabb::EMPTY,
+        centroids: Aabb::EMPTY,
+    };
+
+    /// Grown by one primitive.
+    pub fn grow(self, input: &Input, it: &Item) -> RangeBounds {
+        RangeBounds {
+            prims: self.prims.union(input.bounds_of(it)),
+            centroids: self.centroids.grow(it.centroid()),
+        }
+    }
+
+    fn union(self, o: RangeBounds) -> RangeBounds {
+        RangeBounds {
+            prims: self.prims.union(o.prims),
+            centroids: self.centroids.union(o.centroids),
+        }
+    }
 }
 
 /// Builds a BVH over primitives given their bounds and centroids, with its wide form.
@@ -56,51 +100,67 @@ pub fn build(bounds: &[Aabb], centroids: &[Vec3], options: BuildOptions) -> Bvh 
 /// (after dropping the build's inputs, to keep the peak memory down).
 pub fn build_binary(bounds: &[Aabb], centroids: &[Vec3], options: BuildOptions) -> Bvh {
     assert_eq!(bounds.len(), centroids.len());
-    if bounds.is_empty() {
-        return Bvh::default();
-    }
     let points = bounds
         .par_iter()
         .zip(centroids.par_iter())
         .all(|(b, &c)| b.min == c && b.max == c);
+    build_with(
+        centroids.len(),
+        |i| centroids[i],
+        (!points).then_some(bounds),
+        options,
+    )
+}
+
+/// [`build_binary`] for points (every primitive's box is its centroid): the same tree,
+/// without the boxes in memory.
+pub fn build_binary_points(points: &[Vec3], options: BuildOptions) -> Bvh {
+    build_with(points.len(), |i| points[i], None, options)
+}
+
+/// [`build_binary`] over `n` primitives whose centroids are `centroid(i)`, with their
+/// boxes in `bounds`, or `None` when every box is its centroid (points): callers that
+/// hold their primitives need no copy of the centroids.
+pub fn build_with(
+    n: usize,
+    centroid: impl Fn(usize) -> Vec3 + Sync,
+    bounds: Option<&[Aabb]>,
+    options: BuildOptions,
+) -> Bvh {
+    assert!(bounds.is_none_or(|b| b.len() == n));
+    if n == 0 {
+        return Bvh::default();
+    }
     let input = Input {
         bounds,
-        centroids,
         leaf_size: options.leaf_size.max(1),
-        points,
     };
-    let mut order: Vec<u32> = (0..bounds.len() as u32).collect();
-    let rb = bounds
-        .par_iter()
-        .zip(centroids.par_iter())
-        .fold(
-            || RangeBounds {
-                prims: Aabb::EMPTY,
-                centroids: Aabb::EMPTY,
-            },
-            |acc, (b, &c)| RangeBounds {
-                prims: acc.prims.union(*b),
-                centroids: acc.centroids.grow(c),
-            },
-        )
-        .reduce(
-            || RangeBounds {
-                prims: Aabb::EMPTY,
-                centroids: Aabb::EMPTY,
-            },
-            |a, b| RangeBounds {
-                prims: a.prims.union(b.prims),
-                centroids: a.centroids.union(b.centroids),
-            },
-        );
-    let built = build_range(&input, &mut order, 0, rb);
-    let mut nodes = Vec::with_capacity(built.len());
-    built.flatten(&mut nodes);
+    let mut items: Vec<Item> = (0..n)
+        .into_par_iter()
+        .map(|i| Item {
+            c: centroid(i).to_array(),
+            index: i as u32,
+        })
+        .collect();
+    let rb = items
+        .par_chunks(CHUNK)
+        .map(|chunk| range_bounds(&input, chunk))
+        .reduce(|| RangeBounds::EMPTY, RangeBounds::union);
+    let built = build_range(&input, &mut items, 0, rb);
+    let nodes = built.flatten();
+    let order = items.par_iter().map(|it| it.index).collect();
     Bvh {
         nodes,
         order,
         ..Bvh::default()
     }
+}
+
+/// Bounds of the primitives and of the centroids of `items`.
+pub(super) fn range_bounds(input: &Input, items: &[Item]) -> RangeBounds {
+    items
+        .iter()
+        .fold(RangeBounds::EMPTY, |acc, it| acc.grow(input, it))
 }
 
 /// A subtree as built in parallel: serial pieces (child indices relative to the piece's
@@ -119,24 +179,33 @@ impl Built {
         }
     }
 
-    /// Appends the subtree depth-first to `out`, fixing the right-child indices.
-    fn flatten(self, out: &mut Vec<Node>) {
+    /// Lays the subtree out depth-first, its pieces copied in parallel.
+    fn flatten(self) -> Vec<Node> {
+        let placeholder = make_node(Aabb::EMPTY, 0, 0, 0);
+        let mut out = Vec::with_capacity(self.len());
+        out.par_extend(rayon::iter::repeat_n(placeholder, self.len()));
+        self.write(&mut out, 0);
+        out
+    }
+
+    /// Writes the subtree depth-first into `out` (exactly [`Built::len`] nodes), whose
+    /// first node has index `base` in the whole array, fixing the right-child indices.
+    fn write(self, out: &mut [Node], base: u32) {
         match self {
             Built::Serial(v) => {
-                let base = out.len() as u32;
-                out.extend(v.into_iter().map(|mut n| {
+                for (o, mut n) in out.iter_mut().zip(v) {
                     if !n.is_leaf() {
                         n.index += base;
                     }
-                    n
-                }));
+                    *o = n;
+                }
             }
-            Built::Split(node, l, r) => {
-                let here = out.len();
-                out.push(node);
-                l.flatten(out);
-                out[here].index = out.len() as u32;
-                r.flatten(out);
+            Built::Split(mut node, l, r) => {
+                let (head, rest) = out.split_at_mut(1);
+                let (left, right) = rest.split_at_mut(l.len());
+                node.index = base + 1 + left.len() as u32;
+                head[0] = node;
+                rayon::join(|| l.write(left, base + 1), || r.write(right, node.index));
             }
         }
     }
@@ -144,9 +213,10 @@ impl Built {
 
 /// Builds the subtree over `items` (which start at `offset` in the final order), in
 /// parallel above `PARALLEL_MIN` items.
-fn build_range(input: &Input, items: &mut [u32], offset: usize, rb: RangeBounds) -> Built {
+fn build_range(input: &Input, items: &mut [Item], offset: usize, rb: RangeBounds) -> Built {
     if items.len() < PARALLEL_MIN {
-        let mut nodes = Vec::with_capacity(2 * items.len() / input.leaf_size + 1);
+        // At most 2n - 1 nodes; only the pages written are ever touched.
+        let mut nodes = Vec::with_capacity(2 * items.len() - 1);
         build_serial(input, items, offset, rb, &mut nodes);
         return Built::Serial(nodes);
     }
@@ -162,7 +232,7 @@ fn build_range(input: &Input, items: &mut [u32], offset: usize, rb: RangeBounds)
 
 fn build_serial(
     input: &Input,
-    items: &mut [u32],
+    items: &mut [Item],
     offset: usize,
     rb: RangeBounds,
     nodes: &mut Vec<Node>,
@@ -196,43 +266,9 @@ fn make_node(b: Aabb, index: u32, count: u32, size: usize) -> Node {
     }
 }
 
-fn half_area(b: &Aabb) -> f32 {
-    if b.is_empty() {
-        return 0.0;
-    }
-    let e = b.extent();
-    e.x * e.y + e.y * e.z + e.z * e.x
-}
-
-/// Per-bin counts, primitive bounds and centroid bounds.
-#[derive(Clone, Copy)]
-struct Bins {
-    count: [usize; BINS],
-    prims: [Aabb; BINS],
-    centroids: [Aabb; BINS],
-}
-
-impl Bins {
-    fn new() -> Bins {
-        Bins {
-            count: [0; BINS],
-            prims: [Aabb::EMPTY; BINS],
-            centroids: [Aabb::EMPTY; BINS],
-        }
-    }
-    fn merge(mut self, o: Bins) -> Bins {
-        for k in 0..BINS {
-            self.count[k] += o.count[k];
-            self.prims[k] = self.prims[k].union(o.prims[k]);
-            self.centroids[k] = self.centroids[k].union(o.centroids[k]);
-        }
-        self
-    }
-}
-
 /// Partitions `items` into two non-empty halves; returns the split position and the
 /// bounds of both halves.
-fn split(input: &Input, items: &mut [u32], rb: RangeBounds) -> (usize, RangeBounds, RangeBounds) {
+fn split(input: &Input, items: &mut [Item], rb: RangeBounds) -> (usize, RangeBounds, RangeBounds) {
     let ext = rb.centroids.extent();
     let axis = if ext.x >= ext.y && ext.x >= ext.z {
         0
@@ -241,39 +277,30 @@ fn split(input: &Input, items: &mut [u32], rb: RangeBounds) -> (usize, RangeBoun
     } else {
         2
     };
-    let lo = rb.centroids.min[axis];
     let width = ext[axis];
     if width.is_nan() || width <= 0.0 {
         return median_split(input, items, axis);
     }
-    let scale = BINS as f32 / width;
-    let bin_of = |i: u32| -> usize {
-        let c = input.centroids[i as usize][axis];
-        (((c - lo) * scale) as usize).min(BINS - 1)
+    if items.len() <= SWEEP_MAX {
+        return sweep_split(input, items, axis);
+    }
+    let binning = Binning {
+        axis,
+        lo: rb.centroids.min[axis],
+        scale: BINS as f32 / width,
     };
-    let bin_all = |chunk: &[u32]| {
-        let mut b = Bins::new();
-        for &i in chunk {
-            let k = bin_of(i);
-            b.count[k] += 1;
-            if !input.points {
-                b.prims[k] = b.prims[k].union(input.bounds[i as usize]);
-            }
-            b.centroids[k] = b.centroids[k].grow(input.centroids[i as usize]);
-        }
-        b
+    let bin_all = |chunk: &[Item]| match input.bounds {
+        Some(bounds) => bins::bin_boxes(chunk, bounds, binning),
+        None => bins::bin_points(chunk, binning),
     };
-    let mut bins = if items.len() >= PARALLEL_BINNING_MIN {
+    let bins = if items.len() >= PARALLEL_BINNING_MIN {
         items
-            .par_chunks(64 * 1024)
+            .par_chunks(CHUNK)
             .map(bin_all)
             .reduce(Bins::new, Bins::merge)
     } else {
         bin_all(items)
     };
-    if input.points {
-        bins.prims = bins.centroids;
-    }
     // Suffix costs from the right, then the best split from the left.
     let mut right_cost = [0f32; BINS];
     let (mut acc_b, mut acc_n) = (Aabb::EMPTY, 0usize);
@@ -300,44 +327,28 @@ fn split(input: &Input, items: &mut [u32], rb: RangeBounds) -> (usize, RangeBoun
         return median_split(input, items, axis);
     }
     let gather = |range: std::ops::Range<usize>| {
-        range.fold(
-            RangeBounds {
-                prims: Aabb::EMPTY,
-                centroids: Aabb::EMPTY,
-            },
-            |acc, k| RangeBounds {
-                prims: acc.prims.union(bins.prims[k]),
-                centroids: acc.centroids.union(bins.centroids[k]),
-            },
-        )
+        range.fold(RangeBounds::EMPTY, |acc, k| {
+            acc.union(RangeBounds {
+                prims: bins.prims[k],
+                centroids: bins.centroids[k],
+            })
+        })
     };
     let mid: usize = bins.count[..=best].iter().sum();
-    // `bin_of(i) <= best` without the integer conversion: the bin index is the scaled
-    // offset truncated (0 below the range, NaN included), and best + 1 < BINS.
-    let cut = (best + 1) as f32;
-    partition(items, |i| {
-        let v = (input.centroids[i as usize][axis] - lo) * scale;
-        v < cut || v.is_nan()
-    });
+    partition(items, |it| binning.below(it, best + 1));
     (mid, gather(0..best + 1), gather(best + 1..BINS))
 }
 
-/// In-place partition: items satisfying `left` first (unstable).
-fn partition(items: &mut [u32], left: impl Fn(u32) -> bool) {
-    let (mut i, mut j) = (0usize, items.len());
-    loop {
-        while i < j && left(items[i]) {
-            i += 1;
-        }
-        while i < j && !left(items[j - 1]) {
-            j -= 1;
-        }
-        if i >= j {
-            break;
-        }
-        items.swap(i, j - 1);
-        i += 1;
-        j -= 1;
+/// In-place partition: items satisfying `left` first (unstable). Branch-free (Lomuto's
+/// scheme with the swap done unconditionally): which side an item goes to is a coin
+/// flip for the processor, and a mispredicted branch per item cost more than the extra
+/// writes.
+fn partition(items: &mut [Item], left: impl Fn(&Item) -> bool) {
+    let mut l = 0;
+    for i in 0..items.len() {
+        let goes_left = left(&items[i]);
+        items.swap(i, l);
+        l += usize::from(goes_left);
     }
 }
 
@@ -345,26 +356,135 @@ fn partition(items: &mut [u32], left: impl Fn(u32) -> bool) {
 /// bounds are computed directly (this path is rare: coincident centroids).
 fn median_split(
     input: &Input,
-    items: &mut [u32],
+    items: &mut [Item],
     axis: usize,
 ) -> (usize, RangeBounds, RangeBounds) {
     let mid = items.len() / 2;
-    items.select_nth_unstable_by(mid, |&a, &b| {
-        let ca = input.centroids[a as usize][axis];
-        let cb = input.centroids[b as usize][axis];
-        ca.total_cmp(&cb)
-    });
-    let bounds_of = |s: &[u32]| {
-        s.iter().fold(
-            RangeBounds {
-                prims: Aabb::EMPTY,
-                centroids: Aabb::EMPTY,
-            },
-            |acc, &i| RangeBounds {
-                prims: acc.prims.union(input.bounds[i as usize]),
-                centroids: acc.centroids.grow(input.centroids[i as usize]),
-            },
-        )
-    };
-    (mid, bounds_of(&items[..mid]), bounds_of(&items[mid..]))
+    items.select_nth_unstable_by(mid, |a, b| a.c[axis].total_cmp(&b.c[axis]));
+    (
+        mid,
+        range_bounds(input, &items[..mid]),
+        range_bounds(input, &items[mid..]),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::bins::test_random as random;
+    use crate::bvh::validate;
+
+    /// Point sets of every shape the build meets: uniform, on a line (two empty extents),
+    /// clustered with many exact duplicates, all coincident.
+    fn point_sets(n: usize) -> Vec<(&'static str, Vec<Vec3>)> {
+        let mut r = random(n as u32 + 11);
+        let uniform = (0..n).map(|_| Vec3::new(r(), r(), r())).collect();
+        let line = (0..n).map(|_| Vec3::new(r() * 100.0, 2.0, -3.0)).collect();
+        let dup = (0..n)
+            .map(|i| match i % 3 {
+                0 => Vec3::new(0.5, 0.5, 0.5),
+                _ => Vec3::new((r() * 4.0).floor(), (r() * 4.0).floor(), 0.0),
+            })
+            .collect();
+        let same = vec![Vec3::new(-1.0, 7.0, 1e-3); n];
+        vec![
+            ("uniform", uniform),
+            ("line", line),
+            ("duplicates", dup),
+            ("coincident", same),
+        ]
+    }
+
+    const SIZES: [usize; 9] = [0, 1, 2, 3, 5, 17, 33, 1000, 70_000];
+
+    /// Checks what `validate` does, plus: every node's box is exactly the box of the
+    /// primitives below it (tight), and leaves hold 1 ..= leaf_size primitives.
+    fn check(bvh: &Bvh, bounds: &[Aabb], leaf_size: usize, what: &str) {
+        validate(bvh, bounds).unwrap_or_else(|e| panic!("{what}: {e}"));
+        if bounds.is_empty() {
+            assert!(bvh.nodes.is_empty(), "{what}");
+            return;
+        }
+        fn tight(bvh: &Bvh, bounds: &[Aabb], i: usize, leaf_size: usize, what: &str) -> Aabb {
+            let n = &bvh.nodes[i];
+            let b = if n.is_leaf() {
+                assert!(
+                    (1..=leaf_size as u32).contains(&n.count),
+                    "{what}: leaf {i}"
+                );
+                let (f, c) = (n.index as usize, n.count as usize);
+                bvh.order[f..f + c]
+                    .iter()
+                    .fold(Aabb::EMPTY, |acc, &o| acc.union(bounds[o as usize]))
+            } else {
+                let l = tight(bvh, bounds, i + 1, leaf_size, what);
+                l.union(tight(bvh, bounds, n.index as usize, leaf_size, what))
+            };
+            assert_eq!((n.min, n.max), (b.min, b.max), "{what}: node {i} not tight");
+            assert_eq!(n.diam, b.diagonal() as f32, "{what}: node {i} diameter");
+            b
+        }
+        tight(bvh, bounds, 0, leaf_size, what);
+    }
+
+    #[test]
+    fn point_builds_are_valid_for_every_size_and_shape() {
+        for n in SIZES {
+            for (shape, pts) in point_sets(n) {
+                let bounds: Vec<Aabb> = pts.iter().map(|&p| Aabb { min: p, max: p }).collect();
+                for leaf_size in [1, 4] {
+                    let options = BuildOptions { leaf_size };
+                    let what = format!("{shape}, n = {n}, leaf size {leaf_size}");
+                    let points = build_binary_points(&pts, options);
+                    check(&points, &bounds, leaf_size, &what);
+                    // The general entry point detects points and builds the same tree.
+                    let general = build_binary(&bounds, &pts, options);
+                    assert_eq!(points.nodes, general.nodes, "{what}");
+                    assert_eq!(points.order, general.order, "{what}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn box_builds_are_valid_for_every_size_and_shape() {
+        for n in SIZES {
+            for (shape, pts) in point_sets(n) {
+                // Boxes of random size around the points, some flat, centroid off-centre.
+                let mut r = random(n as u32);
+                let bounds: Vec<Aabb> = pts
+                    .iter()
+                    .map(|&p| {
+                        let e = Vec3::new(r(), r() * 0.1, if r() < 0.3 { 0.0 } else { r() });
+                        Aabb {
+                            min: p - 0.25 * e,
+                            max: p + e,
+                        }
+                    })
+                    .collect();
+                let what = format!("{shape} boxes, n = {n}");
+                let bvh = build_binary(&bounds, &pts, BuildOptions::default());
+                check(&bvh, &bounds, 4, &what);
+            }
+        }
+    }
+
+    #[test]
+    fn partition_puts_exactly_the_left_items_first() {
+        let mut r = random(3);
+        let mut items: Vec<Item> = (0..1000)
+            .map(|i| Item {
+                c: [r(), r(), r()],
+                index: i,
+            })
+            .collect();
+        let left = |it: &Item| it.c[1] < 0.3;
+        let expected = items.iter().filter(|it| left(it)).count();
+        partition(&mut items, left);
+        assert!(items[..expected].iter().all(left));
+        assert!(!items[expected..].iter().any(left));
+        let mut seen: Vec<u32> = items.iter().map(|it| it.index).collect();
+        seen.sort_unstable();
+        assert!(seen.iter().copied().eq(0..1000));
+    }
 }

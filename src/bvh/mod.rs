@@ -6,11 +6,13 @@
 //! stores its primitive count (the `n` of a Barnes-Hut far-field term) and the length
 //! of its box diagonal (the `diam(B)` of the opening criterion).
 
+mod bins;
 mod build;
+mod sweep;
 mod validate;
 pub mod wide;
 
-pub use build::{BuildOptions, build, build_binary};
+pub use build::{BuildOptions, build, build_binary, build_binary_points, build_with};
 pub use validate::validate;
 pub use wide::{Node4, Root};
 

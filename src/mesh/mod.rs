@@ -9,6 +9,7 @@
 mod error;
 mod obj;
 mod ply;
+mod ply_binary;
 mod ply_check;
 mod stl;
 mod vertex_colours;
@@ -16,6 +17,7 @@ mod vertex_colours;
 pub use error::MeshError;
 
 use glam::Vec3;
+use rayon::prelude::*;
 use std::path::Path;
 
 /// Vertices and the simplices a source provides.
@@ -154,6 +156,13 @@ impl Mesh {
                 path: path.to_path_buf(),
             });
         }
+        // One vectorised pass accepts valid input (NaN fails the comparison too); the
+        // loops below find the first offending vertex and say why.
+        let limit = Vec3::splat(crate::limits::MAX_COORD as f32);
+        let accepted = |v: &[Vec3]| v.iter().all(|v| v.abs().cmple(limit).all());
+        if self.vertices.par_chunks(1 << 16).all(accepted) {
+            return self.validate_indices(path);
+        }
         if let Some(i) = self.vertices.iter().position(|v| !v.is_finite()) {
             return Err(MeshError::NonFinite {
                 path: path.to_path_buf(),
@@ -171,6 +180,11 @@ impl Mesh {
                 }
             }
         }
+        self.validate_indices(path)
+    }
+
+    /// Every segment and triangle index names a vertex.
+    fn validate_indices(&self, path: &Path) -> Result<(), MeshError> {
         let n = self.vertices.len();
         let bad = self
             .segments
@@ -195,9 +209,9 @@ impl Mesh {
 
     /// Applies `p -> rotation * (scale * p) + translation` to every vertex.
     pub fn transform(&mut self, scale: Vec3, rotation: glam::Quat, translation: Vec3) {
-        for v in &mut self.vertices {
-            *v = rotation * (scale * *v) + translation;
-        }
+        self.vertices
+            .par_iter_mut()
+            .for_each(|v| *v = rotation * (scale * *v) + translation);
     }
 
     /// Unique undirected edges of the triangles, each as `[min, max]`, sorted.

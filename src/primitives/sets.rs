@@ -5,6 +5,7 @@ use super::PrimitiveKind;
 use super::kinds::{Edge, Point, Primitive, Triangle};
 use crate::bvh::{self, BuildOptions, Bvh};
 use crate::mesh::{Aabb, Mesh};
+use glam::Vec3;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -38,17 +39,58 @@ pub struct PrimitiveSet<P> {
     pub times: BuildTimes,
 }
 
+impl PrimitiveSet<Point> {
+    /// The points of `vertices`, built straight from the vertex array (the points are
+    /// made once, in leaf order).
+    pub fn from_vertices(vertices: &[Vec3], options: BuildOptions) -> Self {
+        let t = Instant::now();
+        let bvh = bvh::build_binary_points(vertices, options);
+        Self::finish(
+            bvh,
+            |i| Point {
+                p: vertices[i as usize],
+            },
+            1.0,
+            t,
+            0.0,
+        )
+    }
+}
+
 impl<P: Primitive> PrimitiveSet<P> {
     /// Builds the BVH over `prims` and reorders them into leaf order.
     pub fn new(prims: Vec<P>, max_adj: f64, options: BuildOptions, prim_seconds: f64) -> Self {
         let t = Instant::now();
-        let bounds: Vec<Aabb> = prims.par_iter().map(|p| p.bounds()).collect();
-        let centroids: Vec<_> = prims.par_iter().map(|p| p.centroid()).collect();
-        let mut bvh = bvh::build_binary(&bounds, &centroids, options);
-        drop((bounds, centroids));
-        let sorted: Vec<P> = bvh.order.par_iter().map(|&i| prims[i as usize]).collect();
-        drop(prims);
-        bvh.make_wide();
+        // Points (every box is its centroid) build without a copy of their boxes.
+        let points = prims.par_iter().all(|p| {
+            let (b, c) = (p.bounds(), p.centroid());
+            b.min == c && b.max == c
+        });
+        let centroid = |i: usize| prims[i].centroid();
+        let bvh = if points {
+            bvh::build_with(prims.len(), centroid, None, options)
+        } else {
+            let bounds: Vec<Aabb> = prims.par_iter().map(|p| p.bounds()).collect();
+            bvh::build_with(prims.len(), centroid, Some(&bounds), options)
+        };
+        Self::finish(bvh, |i| prims[i as usize], max_adj, t, prim_seconds)
+    }
+
+    /// Puts the primitives (`source(i)` for input index `i`) in leaf order and makes the
+    /// wide form, in parallel (the wide form reads only the nodes).
+    fn finish(
+        mut bvh: Bvh,
+        source: impl Fn(u32) -> P + Sync,
+        max_adj: f64,
+        t: Instant,
+        prim_seconds: f64,
+    ) -> Self {
+        let order = std::mem::take(&mut bvh.order);
+        let (sorted, ()) = rayon::join(
+            || order.par_iter().map(|&i| source(i)).collect::<Vec<P>>(),
+            || bvh.make_wide(),
+        );
+        bvh.order = order;
         let bounds = bvh
             .nodes
             .first()
@@ -117,8 +159,7 @@ impl AnySet {
         }
         Ok(match kind {
             PrimitiveKind::Points => {
-                let prims = points(mesh);
-                AnySet::Points(PrimitiveSet::new(prims, 1.0, options, secs(t)))
+                AnySet::Points(PrimitiveSet::from_vertices(&mesh.vertices, options))
             }
             PrimitiveKind::Edges => {
                 let (prims, max_adj) = edges(mesh).ok_or_else(|| {
@@ -174,10 +215,6 @@ impl AnySet {
 
 fn secs(t: Instant) -> f64 {
     t.elapsed().as_secs_f64()
-}
-
-fn points(mesh: &Mesh) -> Vec<Point> {
-    mesh.vertices.par_iter().map(|&p| Point { p }).collect()
 }
 
 /// Edges: the mesh's explicit segments, or else the unique edges of its triangles.
