@@ -196,6 +196,8 @@ pub struct Tracer<'a> {
     tolerance: Vec<f64>,
     /// Opening parameter per object of the evaluations that decide hits (item 9).
     hit_beta: Vec<f64>,
+    /// Some object decides hits at a finer beta than its steps.
+    refine: bool,
     /// Union of the grown object boxes.
     min: DVec3,
     max: DVec3,
@@ -216,7 +218,7 @@ impl<'a> Tracer<'a> {
             .map(|o| (0.005 * o.params.alpha * options.epsilon).min(1e-3))
             .collect();
         // Point clouds keep the scene's beta for hits (item 9).
-        let hit_beta = objects
+        let hit_beta: Vec<f64> = objects
             .iter()
             .map(|o| {
                 let points_only = o.sets.iter().all(|s| matches!(s, AnySet::Points(_)));
@@ -228,12 +230,17 @@ impl<'a> Tracer<'a> {
                 o.params.beta * scale.clamp(0.0, 1.0)
             })
             .collect();
+        let refine = objects
+            .iter()
+            .zip(&hit_beta)
+            .any(|(o, &b)| b != o.params.beta);
         Tracer {
             objects,
             sets: objects.iter().map(|o| o.set_refs()).collect(),
             reach,
             tolerance,
             hit_beta,
+            refine,
             min,
             max,
             options,
@@ -409,7 +416,7 @@ impl<'a> Tracer<'a> {
         let mut want = Want::Value;
         // Once set, every full evaluation of the ray is accurate (module docs, item 9).
         let mut accurate = false;
-        let refine = self.options.hit_beta_scale < 1.0;
+        let refine = self.refine;
         while t <= t_max {
             if stats.evals + stats.coarse_evals >= self.options.max_steps {
                 stats.exhausted = true;
