@@ -4,7 +4,10 @@
 //! `cargo run --release --example ray_probe -- scenes/deer_alpha1.toml [W H]`
 //! Other modes, after `W H`: `PX PY` (one pixel with and without relaxed steps, and the
 //! field around its hit), `evalstats` (exact, far, pruned terms and nodes per full
-//! evaluation near hits), `histogram` (full evaluations per hit ray).
+//! evaluation near hits), `histogram` (full evaluations per hit ray), `cgf` (points only:
+//! step length over `s` before hits from the quadratic bound, Bennett's inequality,
+//! `eval::reach` and the exact per-term bound, against the distance left to the hit),
+//! `cost` (microseconds per evaluation: value, value with free distance, gradient).
 use glam::DVec3;
 use smoothtrace::eval::evaluate_value;
 use smoothtrace::render::build::build_scene;
