@@ -14,7 +14,11 @@ pub mod colour;
 pub mod nearest;
 pub mod reach;
 pub mod smooth;
+pub mod walk;
 
 pub use accumulate::Accumulation;
 pub use nearest::{Nearest, nearest};
-pub use smooth::{EvalParams, EvalStats, Sample, evaluate, evaluate_reach, evaluate_value};
+pub use smooth::{
+    EvalParams, EvalStats, Sample, evaluate, evaluate_reach, evaluate_value, evaluate_with_cut,
+};
+pub use walk::Cut;

@@ -26,9 +26,8 @@
 
 use super::accumulate::{Accumulation, Accumulator};
 use super::reach::Slopes;
-use crate::bvh::Node4;
-use crate::bvh::wide::EMPTY;
-use crate::primitives::{AnySet, Primitive, PrimitiveSet, WeightScale};
+use super::walk::{Cut, STACK, Walk};
+use crate::primitives::{AnySet, Primitive, WeightScale};
 use glam::DVec3;
 
 /// Relative size of the sum that pruned subtrees may add up to at most, by default
@@ -116,13 +115,13 @@ pub struct Sample {
 
 /// Evaluates the smooth distance of the union of `sets` at `x`, with its gradient.
 pub fn evaluate(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
-    evaluate_impl::<true, false>(sets, x, DVec3::ZERO, p, 0.0)
+    evaluate_impl::<true, false>(sets, x, DVec3::ZERO, p, 0.0, None)
 }
 
 /// Evaluates the smooth distance only (the returned gradient is zero): what a sphere
 /// tracer needs for its steps, at about half the cost.
 pub fn evaluate_value(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
-    evaluate_impl::<false, false>(sets, x, DVec3::ZERO, p, 0.0)
+    evaluate_impl::<false, false>(sets, x, DVec3::ZERO, p, 0.0, None)
 }
 
 /// Evaluates the smooth distance (with the gradient if `grad`) and how far along the
@@ -137,12 +136,29 @@ pub fn evaluate_reach(
     max_len: f64,
     grad: bool,
 ) -> Sample {
+    evaluate_with_cut(sets, x, Some((u, max_len)), p, grad, None)
+}
+
+/// The general evaluation: with the gradient if `grad`, with the free distance along
+/// `along = (u, max_len)` if given (as [`evaluate_reach`]), and, if `cut` is given,
+/// starting from the frontiers it kept from its last evaluation of the same sets with
+/// the same parameters (at any earlier position: the result is as conservative and at
+/// least as accurate as a walk from the roots, `eval::walk`), keeping this one's.
+pub fn evaluate_with_cut(
+    sets: &[&AnySet],
+    x: DVec3,
+    along: Option<(DVec3, f64)>,
+    p: &EvalParams,
+    grad: bool,
+    cut: Option<&mut Cut>,
+) -> Sample {
     let points = sets.iter().all(|s| matches!(s, AnySet::Points(_)));
-    match (points && p.accumulation == Accumulation::Stable, grad) {
-        (true, true) => evaluate_impl::<true, true>(sets, x, u, p, max_len),
-        (true, false) => evaluate_impl::<false, true>(sets, x, u, p, max_len),
-        (false, true) => evaluate(sets, x, p),
-        (false, false) => evaluate_value(sets, x, p),
+    let slope = points && p.accumulation == Accumulation::Stable;
+    match (along.filter(|_| slope), grad) {
+        (Some((u, len)), true) => evaluate_impl::<true, true>(sets, x, u, p, len, cut),
+        (Some((u, len)), false) => evaluate_impl::<false, true>(sets, x, u, p, len, cut),
+        (None, true) => evaluate_impl::<true, false>(sets, x, DVec3::ZERO, p, 0.0, cut),
+        (None, false) => evaluate_impl::<false, false>(sets, x, DVec3::ZERO, p, 0.0, cut),
     }
 }
 
@@ -165,6 +181,7 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
     u: DVec3,
     p: &EvalParams,
     max_len: f64,
+    mut cut: Option<&mut Cut>,
 ) -> Sample {
     let mut acc = Accumulator::new(p.alpha, p.accumulation);
     let mut slopes = Slopes::default();
@@ -175,15 +192,32 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
     } else {
         f64::INFINITY
     };
+    let resume = cut.as_deref_mut().is_some_and(|c| c.prepare(sets, p));
     STACK.with_borrow_mut(|stack| {
-        for set in sets {
+        for (i, set) in sets.iter().enumerate() {
             let sc = scale(set);
             let mut sink = Sink::<GRAD, SLOPE> {
                 acc: &mut acc,
                 slopes: &mut slopes,
                 u,
             };
-            crate::with_set!(set, s => traverse(s, x, p, &sc, prune_margin, &mut sink, &mut stats, stack));
+            let (old, mut new) = match cut.as_deref_mut() {
+                Some(c) => c.take(i),
+                None => Default::default(),
+            };
+            crate::with_set!(set, s => {
+                let record = cut.is_some().then_some(&mut new);
+                let mut walk =
+                    Walk::new(s, x, p, &sc, prune_margin, &mut sink, &mut stats, stack, record);
+                if resume {
+                    walk.from_parts(&old);
+                } else {
+                    walk.from_root();
+                }
+            });
+            if let Some(c) = cut.as_deref_mut() {
+                c.put(i, new, old);
+            }
         }
     });
     let kept = acc.shifted_sum();
@@ -211,39 +245,12 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
     }
 }
 
-/// A traversal stack entry: wide node (or first primitive of a leaf), the leaf's
-/// primitive count (0 for a wide node), squared distance to its box.
-type Entry = (u32, u32, f64);
-
-thread_local! {
-    /// Each thread's traversal stack, kept between evaluations (it holds at most three
-    /// entries per level of the wide tree plus one).
-    static STACK: std::cell::RefCell<Vec<Entry>> = const { std::cell::RefCell::new(Vec::new()) };
-}
-
-/// Squared distances from `x` to the four child boxes of a wide node (0 inside; `+inf`
-/// for an unused slot, whose box is inverted), in f64, four lanes at a time.
-#[inline]
-fn child_distances2(node: &Node4, x: DVec3) -> [f64; 4] {
-    let mut d2 = [0.0f64; 4];
-    for (a, xa) in x.to_array().into_iter().enumerate() {
-        for (k, d2k) in d2.iter_mut().enumerate() {
-            let below = node.min[a][k] as f64 - xa;
-            let above = xa - node.max[a][k] as f64;
-            let d = if below > above { below } else { above };
-            let d = if d > 0.0 { d } else { 0.0 };
-            *d2k += d * d;
-        }
-    }
-    d2
-}
-
 /// Where a traversal's terms go: the accumulator, with the gradient if `GRAD`, and the
 /// terms' slopes along `u`, binned for the free distance, if `SLOPE` (`eval::reach`).
-struct Sink<'a, const GRAD: bool, const SLOPE: bool> {
-    acc: &'a mut Accumulator,
-    slopes: &'a mut Slopes,
-    u: DVec3,
+pub(super) struct Sink<'a, const GRAD: bool, const SLOPE: bool> {
+    pub acc: &'a mut Accumulator,
+    pub slopes: &'a mut Slopes,
+    pub u: DVec3,
 }
 
 impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
@@ -260,7 +267,7 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
 
     /// The far-field term of a subtree with box `min..max` at squared distance `r2 > 0`.
     #[inline]
-    fn far(&mut self, x: DVec3, r2: f64, weight: f64, min: DVec3, max: DVec3) {
+    pub fn far(&mut self, x: DVec3, r2: f64, weight: f64, min: DVec3, max: DVec3) {
         let r = r2.sqrt();
         let m = self.acc.m;
         if GRAD {
@@ -280,7 +287,7 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
 
     /// A primitive's exact term.
     #[inline]
-    fn exact<P: Primitive>(&mut self, prim: &P, x: DVec3, scale: &WeightScale) {
+    pub fn exact<P: Primitive>(&mut self, prim: &P, x: DVec3, scale: &WeightScale) {
         let m = self.acc.m;
         if GRAD {
             let t = prim.term(x, scale);
@@ -295,127 +302,6 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
         } else {
             let (d, w) = prim.value(x, scale);
             self.acc.add_value(d, w);
-        }
-    }
-}
-
-#[allow(clippy::too_many_arguments)]
-fn traverse<P: Primitive, const GRAD: bool, const SLOPE: bool>(
-    set: &PrimitiveSet<P>,
-    x: DVec3,
-    p: &EvalParams,
-    scale: &WeightScale,
-    prune_margin: f64,
-    sink: &mut Sink<GRAD, SLOPE>,
-    stats: &mut EvalStats,
-    stack: &mut Vec<Entry>,
-) {
-    let bvh = &set.bvh;
-    let Some(root) = bvh.wide_root else {
-        return;
-    };
-    let wide = &bvh.wide;
-    let w_ff = scale.max_weight();
-    let beta2 = p.beta * p.beta;
-    let inv_alpha = 1.0 / p.alpha;
-    // The root is a child slot like any other: far field, or pushed.
-    let (rmin, rmax) = (
-        DVec3::from(root.min.map(f64::from)),
-        DVec3::from(root.max.map(f64::from)),
-    );
-    let r2 = (x - x.clamp(rmin, rmax)).length_squared();
-    if root.count == 0 && p.beta > 0.0 && (root.diam2 as f64) < beta2 * r2 {
-        sink.far(x, r2, root.size as f64 * w_ff, rmin, rmax);
-        stats.far += 1;
-        return;
-    }
-    // Entries: (wide node or first primitive, leaf primitive count or 0, squared
-    // distance). Far-field children are summed when their parent is opened; the others
-    // are pushed farthest first, so they are popped near to far.
-    stack.clear();
-    stack.push((root.child, root.count, r2));
-    while let Some((i, count, r2)) = stack.pop() {
-        stats.nodes += 1;
-        let acc = &sink.acc;
-        let reach = acc.m + (prune_margin - acc.ln_sum_lower_bound() * inv_alpha);
-        let reach2 = reach * reach;
-        if r2 > reach2 {
-            stats.pruned += 1;
-            continue;
-        }
-        if count > 0 {
-            let first = i as usize;
-            for prim in &set.prims[first..first + count as usize] {
-                sink.exact(prim, x, scale);
-            }
-            stats.exact += count;
-            continue;
-        }
-        let node = &wide[i as usize];
-        let d2 = child_distances2(node, x);
-        let slot_box = |k: usize| {
-            (
-                DVec3::new(
-                    node.min[0][k] as f64,
-                    node.min[1][k] as f64,
-                    node.min[2][k] as f64,
-                ),
-                DVec3::new(
-                    node.max[0][k] as f64,
-                    node.max[1][k] as f64,
-                    node.max[2][k] as f64,
-                ),
-            )
-        };
-        // Children to open, as (squared distance, slot), sorted farthest first.
-        let mut open = [(0.0f64, 0usize); 4];
-        let mut n = 0;
-        for j in 0..2 {
-            // The middle: pruned or far field as a whole, at the distance of its nearer
-            // child box (a lower bound of every distance below it).
-            let near = if d2[2 * j] <= d2[2 * j + 1] {
-                2 * j
-            } else {
-                2 * j + 1
-            };
-            let r2m = d2[near];
-            if r2m > reach2 {
-                stats.pruned += 1;
-                continue;
-            }
-            if p.beta > 0.0 && (node.mid_diam2[j] as f64) < beta2 * r2m {
-                let (min, max) = slot_box(near);
-                sink.far(x, r2m, node.mid_size[j] as f64 * w_ff, min, max);
-                stats.far += 1;
-                continue;
-            }
-            for k in [2 * j, 2 * j + 1] {
-                let c = node.count[k];
-                if c == EMPTY {
-                    continue;
-                }
-                if d2[k] > reach2 {
-                    stats.pruned += 1;
-                    continue;
-                }
-                if c == 0 && p.beta > 0.0 && (node.diam2[k] as f64) < beta2 * d2[k] {
-                    let (min, max) = slot_box(k);
-                    sink.far(x, d2[k], node.size[k] as f64 * w_ff, min, max);
-                    stats.far += 1;
-                    continue;
-                }
-                // Insertion into the farthest-first order.
-                let mut h = n;
-                while h > 0 && open[h - 1].0 < d2[k] {
-                    open[h] = open[h - 1];
-                    h -= 1;
-                }
-                open[h] = (d2[k], k);
-                n += 1;
-            }
-        }
-        for &(r2, k) in &open[..n] {
-            stack.push((node.child[k], node.count[k], r2));
         }
     }
 }
