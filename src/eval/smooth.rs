@@ -26,7 +26,7 @@
 
 use super::accumulate::{Accumulation, Accumulator};
 use super::reach::Slopes;
-use super::walk::{Cut, STACK, Walk};
+use super::walk::{STACK, Walk};
 use crate::primitives::{AnySet, Primitive, WeightScale};
 use glam::DVec3;
 
@@ -115,13 +115,13 @@ pub struct Sample {
 
 /// Evaluates the smooth distance of the union of `sets` at `x`, with its gradient.
 pub fn evaluate(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
-    evaluate_impl::<true, false>(sets, x, DVec3::ZERO, p, 0.0, None)
+    evaluate_impl::<true, false>(sets, x, DVec3::ZERO, p, 0.0)
 }
 
 /// Evaluates the smooth distance only (the returned gradient is zero): what a sphere
 /// tracer needs for its steps, at about half the cost.
 pub fn evaluate_value(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
-    evaluate_impl::<false, false>(sets, x, DVec3::ZERO, p, 0.0, None)
+    evaluate_impl::<false, false>(sets, x, DVec3::ZERO, p, 0.0)
 }
 
 /// Evaluates the smooth distance (with the gradient if `grad`) and how far along the
@@ -136,29 +136,25 @@ pub fn evaluate_reach(
     max_len: f64,
     grad: bool,
 ) -> Sample {
-    evaluate_with_cut(sets, x, Some((u, max_len)), p, grad, None)
+    evaluate_along(sets, x, Some((u, max_len)), p, grad)
 }
 
-/// The general evaluation: with the gradient if `grad`, with the free distance along
-/// `along = (u, max_len)` if given (as [`evaluate_reach`]), and, if `cut` is given,
-/// starting from the frontiers it kept from its last evaluation of the same sets with
-/// the same parameters (at any earlier position: the result is as conservative and at
-/// least as accurate as a walk from the roots, `eval::walk`), keeping this one's.
-pub fn evaluate_with_cut(
+/// The general evaluation: with the gradient if `grad`, and with the free distance
+/// along `along = (u, max_len)` if given (as [`evaluate_reach`]).
+pub fn evaluate_along(
     sets: &[&AnySet],
     x: DVec3,
     along: Option<(DVec3, f64)>,
     p: &EvalParams,
     grad: bool,
-    cut: Option<&mut Cut>,
 ) -> Sample {
     let points = sets.iter().all(|s| matches!(s, AnySet::Points(_)));
     let slope = points && p.accumulation == Accumulation::Stable;
     match (along.filter(|_| slope), grad) {
-        (Some((u, len)), true) => evaluate_impl::<true, true>(sets, x, u, p, len, cut),
-        (Some((u, len)), false) => evaluate_impl::<false, true>(sets, x, u, p, len, cut),
-        (None, true) => evaluate_impl::<true, false>(sets, x, DVec3::ZERO, p, 0.0, cut),
-        (None, false) => evaluate_impl::<false, false>(sets, x, DVec3::ZERO, p, 0.0, cut),
+        (Some((u, len)), true) => evaluate_impl::<true, true>(sets, x, u, p, len),
+        (Some((u, len)), false) => evaluate_impl::<false, true>(sets, x, u, p, len),
+        (None, true) => evaluate_impl::<true, false>(sets, x, DVec3::ZERO, p, 0.0),
+        (None, false) => evaluate_impl::<false, false>(sets, x, DVec3::ZERO, p, 0.0),
     }
 }
 
@@ -181,7 +177,6 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
     u: DVec3,
     p: &EvalParams,
     max_len: f64,
-    mut cut: Option<&mut Cut>,
 ) -> Sample {
     let mut acc = Accumulator::new(p.alpha, p.accumulation);
     let mut slopes = Slopes::default();
@@ -192,32 +187,17 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
     } else {
         f64::INFINITY
     };
-    let resume = cut.as_deref_mut().is_some_and(|c| c.prepare(sets, p));
     STACK.with_borrow_mut(|stack| {
-        for (i, set) in sets.iter().enumerate() {
+        for set in sets {
             let sc = scale(set);
             let mut sink = Sink::<GRAD, SLOPE> {
                 acc: &mut acc,
                 slopes: &mut slopes,
                 u,
             };
-            let (old, mut new) = match cut.as_deref_mut() {
-                Some(c) => c.take(i),
-                None => Default::default(),
-            };
             crate::with_set!(set, s => {
-                let record = cut.is_some().then_some(&mut new);
-                let mut walk =
-                    Walk::new(s, x, p, &sc, prune_margin, &mut sink, &mut stats, stack, record);
-                if resume {
-                    walk.from_parts(&old);
-                } else {
-                    walk.from_root();
-                }
+                Walk::new(s, x, p, &sc, prune_margin, &mut sink, &mut stats, stack).from_root()
             });
-            if let Some(c) = cut.as_deref_mut() {
-                c.put(i, new, old);
-            }
         }
     });
     let kept = acc.shifted_sum();

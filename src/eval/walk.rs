@@ -1,138 +1,23 @@
-//! The Barnes-Hut walk over the wide BVH (SPEC 6), and its frontier kept between
-//! evaluations (a [`Cut`]).
+//! The Barnes-Hut walk over the wide BVH (SPEC 6): the decisions of `eval::smooth`'s
+//! module docs, made for the four slots of a wide node at once.
 //!
 //! A walk decides, for every subtree it meets, one of: pruned (negligible, covered from
 //! above by the caller), far field (one term `n w exp(-alpha r)`), exact (a leaf's
-//! primitives) or opened. The subtrees it does not open form its *frontier*: a partition
-//! of the primitives, each part summed as one term, several exact terms or nothing.
-//!
-//! Every far-field term is an upper bound of the terms it stands for at *every* position
-//! (the box contains them, so the box distance bounds theirs from below), whatever the
-//! opening criterion said; the criterion only decides accuracy. So the frontier of a walk
-//! at `x` is also a valid, conservative set of terms at a nearby `y`, provided every part
-//! is tested again at `y`: a part that is pruned or far at `y` by the same rules as a
-//! fresh walk is summed so, and one that is not is opened from there (a fresh walk of its
-//! subtree). The sum at `y` is then at least as accurate as a fresh walk's (its far terms
-//! are the same nodes or finer ones, and a finer node's term is smaller), and it is
-//! conservative for the same reason. What it saves is the descent from the root: the
-//! steps of a ray near the surface move a few epsilons at a time, and their frontiers
-//! barely change (`Cut`, used by the tracer along each ray).
+//! primitives) or opened.
 
 use super::smooth::{EvalParams, EvalStats, Sink};
 use crate::bvh::Node4;
 use crate::bvh::wide::{EMPTY, Root};
-use crate::primitives::{AnySet, Primitive, PrimitiveSet, WeightScale};
+use crate::primitives::{Primitive, PrimitiveSet, WeightScale};
 use glam::DVec3;
 
-/// A part of a walk's frontier: slot `code` (0..4) of wide node `node`, its middle
-/// `code - 4` (4, 5: the pair of slots 0-1 or 2-3), or the root (`code = ROOT`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Part {
-    node: u32,
-    code: u32,
-}
-
-const MIDDLE: u32 = 4;
-const ROOT: u32 = 6;
-
-impl Part {
-    const ROOT: Part = Part {
-        node: 0,
-        code: ROOT,
-    };
-
-    fn slot(node: u32, k: usize) -> Part {
-        Part {
-            node,
-            code: k as u32,
-        }
-    }
-
-    fn middle(node: u32, j: usize) -> Part {
-        Part {
-            node,
-            code: MIDDLE + j as u32,
-        }
-    }
-}
-
-/// The frontiers of the last evaluation over a list of sets, and what they were
-/// evaluated with: an evaluation with the same sets and parameters starts from them
-/// instead of the roots ([`super::smooth::evaluate_with_cut`]).
-#[derive(Clone, Debug, Default)]
-pub struct Cut {
-    key: Option<Key>,
-    parts: Vec<Vec<Part>>,
-    next: Vec<Part>,
-}
-
-/// What a frontier is valid for: the sets (by address) and the parameters that decide
-/// pruning and far fields.
-#[derive(Clone, Debug, PartialEq)]
-struct Key {
-    sets: Vec<usize>,
-    alpha: u64,
-    max_alpha: u64,
-    beta: u64,
-    prune: bool,
-    tolerance: u64,
-}
-
-impl Key {
-    fn new(sets: &[&AnySet], p: &EvalParams) -> Key {
-        Key {
-            sets: sets.iter().map(|s| *s as *const AnySet as usize).collect(),
-            alpha: p.alpha.to_bits(),
-            max_alpha: p.max_alpha.to_bits(),
-            beta: p.beta.to_bits(),
-            prune: p.prune,
-            tolerance: p.prune_tolerance.to_bits(),
-        }
-    }
-}
-
-impl Cut {
-    /// Forgets the frontiers: the next evaluation walks from the roots.
-    pub fn clear(&mut self) {
-        self.key = None;
-    }
-
-    /// Whether the next evaluation of `sets` with `p` would start from the kept
-    /// frontiers (else it walks from the roots and keeps its own).
-    pub(super) fn prepare(&mut self, sets: &[&AnySet], p: &EvalParams) -> bool {
-        let key = Key::new(sets, p);
-        if self.key.as_ref() == Some(&key) {
-            return true;
-        }
-        self.key = Some(key);
-        self.parts.resize_with(sets.len(), Vec::new);
-        false
-    }
-
-    /// The frontier of set `i` to start from (taken out; give the new one back with
-    /// [`Cut::put`]) and an empty list to record the new one in.
-    pub(super) fn take(&mut self, i: usize) -> (Vec<Part>, Vec<Part>) {
-        let mut next = std::mem::take(&mut self.next);
-        next.clear();
-        (std::mem::take(&mut self.parts[i]), next)
-    }
-
-    /// Keeps `new` as set `i`'s frontier; `old` becomes the next scratch list.
-    pub(super) fn put(&mut self, i: usize, new: Vec<Part>, old: Vec<Part>) {
-        self.parts[i] = new;
-        self.next = old;
-    }
-}
-
 /// A traversal stack entry: wide node (or first primitive of a leaf), the leaf's
-/// primitive count (0 for a wide node), squared distance to its box, and the frontier
-/// part it is (the slot it was pushed from).
+/// primitive count (0 for a wide node), squared distance to its box.
 #[derive(Clone, Copy)]
 pub(super) struct Entry {
     i: u32,
     count: u32,
     r2: f64,
-    part: Part,
 }
 
 thread_local! {
@@ -201,8 +86,7 @@ impl Open {
     }
 }
 
-/// One walk over one set at `x`: its decisions go to the sink and the statistics, and
-/// its frontier to `record` (when kept).
+/// One walk over one set at `x`: its decisions go to the sink and the statistics.
 pub(super) struct Walk<'w, 'a, P, const GRAD: bool, const SLOPE: bool> {
     set: &'w PrimitiveSet<P>,
     x: DVec3,
@@ -210,7 +94,6 @@ pub(super) struct Walk<'w, 'a, P, const GRAD: bool, const SLOPE: bool> {
     sink: &'w mut Sink<'a, GRAD, SLOPE>,
     stats: &'w mut EvalStats,
     stack: &'w mut Vec<Entry>,
-    record: Option<&'w mut Vec<Part>>,
     prune_margin: f64,
     inv_alpha: f64,
     /// `beta^2`, or -1 when far fields are off (beta = 0).
@@ -230,7 +113,6 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         sink: &'w mut Sink<'a, GRAD, SLOPE>,
         stats: &'w mut EvalStats,
         stack: &'w mut Vec<Entry>,
-        record: Option<&'w mut Vec<Part>>,
     ) -> Self {
         Walk {
             set,
@@ -239,7 +121,6 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             sink,
             stats,
             stack,
-            record,
             prune_margin,
             inv_alpha: 1.0 / p.alpha,
             beta2: if p.beta > 0.0 { p.beta * p.beta } else { -1.0 },
@@ -254,13 +135,6 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         let acc = &self.sink.acc;
         let reach = acc.m + (self.prune_margin - acc.ln_sum_lower_bound() * self.inv_alpha);
         reach * reach
-    }
-
-    #[inline(always)]
-    fn keep(&mut self, part: Part) {
-        if let Some(r) = self.record.as_deref_mut() {
-            r.push(part);
-        }
     }
 
     #[inline(always)]
@@ -287,7 +161,6 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             self.sink
                 .far(x, r2, root.size as f64 * self.w_ff, rmin, rmax);
             self.stats.far += 1;
-            self.keep(Part::ROOT);
             return;
         }
         self.stack.clear();
@@ -295,43 +168,8 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             i: root.child,
             count: root.count,
             r2,
-            part: Part::ROOT,
         });
         self.drain();
-    }
-
-    /// A walk that starts from the frontier `parts` of an earlier walk over the same set
-    /// with the same parameters (module docs).
-    pub fn from_parts(&mut self, parts: &[Part]) {
-        let wide = &self.set.bvh.wide;
-        for &part in parts {
-            if part.code == ROOT {
-                self.from_root();
-                continue;
-            }
-            let i = part.node;
-            let node = &wide[i as usize];
-            let reach2 = self.reach2();
-            let mut open = Open::new();
-            if part.code >= MIDDLE {
-                let d2 = child_distances2(node, self.x);
-                self.middle(
-                    node,
-                    i,
-                    (part.code - MIDDLE) as usize,
-                    &d2,
-                    reach2,
-                    &mut open,
-                );
-            } else {
-                let k = part.code as usize;
-                let (min, max) = slot_box(node, k);
-                let r2 = (self.x - self.x.clamp(min, max)).length_squared();
-                self.slot(node, i, k, r2, reach2, &mut open);
-            }
-            self.push(node, i, &open);
-            self.drain();
-        }
     }
 
     /// Pops and decides stack entries until the stack is empty.
@@ -342,7 +180,6 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             let reach2 = self.reach2();
             if e.r2 > reach2 {
                 self.stats.pruned += 1;
-                self.keep(e.part);
                 continue;
             }
             if e.count > 0 {
@@ -351,27 +188,25 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
                     self.sink.exact(prim, self.x, self.scale);
                 }
                 self.stats.exact += e.count;
-                self.keep(e.part);
                 continue;
             }
             let node = &wide[e.i as usize];
             let d2 = child_distances2(node, self.x);
             let mut open = Open::new();
             for j in 0..2 {
-                self.middle(node, e.i, j, &d2, reach2, &mut open);
+                self.middle(node, j, &d2, reach2, &mut open);
             }
-            self.push(node, e.i, &open);
+            self.push(node, &open);
         }
     }
 
     #[inline(always)]
-    fn push(&mut self, node: &Node4, i: u32, open: &Open) {
+    fn push(&mut self, node: &Node4, open: &Open) {
         for &(r2, k) in &open.list[..open.n] {
             self.stack.push(Entry {
                 i: node.child[k],
                 count: node.count[k],
                 r2,
-                part: Part::slot(i, k),
             });
         }
     }
@@ -380,15 +215,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
     /// distance of its nearer child box (a lower bound of every distance below it), or
     /// its two slots one by one.
     #[inline(always)]
-    fn middle(
-        &mut self,
-        node: &Node4,
-        i: u32,
-        j: usize,
-        d2: &[f64; 4],
-        reach2: f64,
-        open: &mut Open,
-    ) {
+    fn middle(&mut self, node: &Node4, j: usize, d2: &[f64; 4], reach2: f64, open: &mut Open) {
         let near = if d2[2 * j] <= d2[2 * j + 1] {
             2 * j
         } else {
@@ -397,7 +224,6 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         let r2m = d2[near];
         if r2m > reach2 {
             self.stats.pruned += 1;
-            self.keep(Part::middle(i, j));
             return;
         }
         if self.far_ok(node.mid_diam2[j], r2m) {
@@ -405,25 +231,23 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             let w = node.mid_size[j] as f64 * self.w_ff;
             self.sink.far(self.x, r2m, w, min, max);
             self.stats.far += 1;
-            self.keep(Part::middle(i, j));
             return;
         }
         for k in [2 * j, 2 * j + 1] {
-            self.slot(node, i, k, d2[k], reach2, open);
+            self.slot(node, k, d2[k], reach2, open);
         }
     }
 
     /// Decides slot `k` of wide node `i` at squared distance `d2k`: pruned, far field,
     /// or to be opened (leaves too: they are summed when popped).
     #[inline(always)]
-    fn slot(&mut self, node: &Node4, i: u32, k: usize, d2k: f64, reach2: f64, open: &mut Open) {
+    fn slot(&mut self, node: &Node4, k: usize, d2k: f64, reach2: f64, open: &mut Open) {
         let c = node.count[k];
         if c == EMPTY {
             return;
         }
         if d2k > reach2 {
             self.stats.pruned += 1;
-            self.keep(Part::slot(i, k));
             return;
         }
         if c == 0 && self.far_ok(node.diam2[k], d2k) {
@@ -431,7 +255,6 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             let w = node.size[k] as f64 * self.w_ff;
             self.sink.far(self.x, d2k, w, min, max);
             self.stats.far += 1;
-            self.keep(Part::slot(i, k));
             return;
         }
         open.insert(d2k, k);

@@ -78,12 +78,6 @@ impl TraceObject {
         p.alpha = alpha;
         p.beta = beta;
         p.prune_tolerance = p.prune_tolerance.max(prune_tolerance);
-        if let Some((u, max_len)) = along {
-            eval::evaluate_reach(sets, x, u, &p, max_len, grad)
-        } else if grad {
-            eval::evaluate(sets, x, &p)
-        } else {
-            eval::evaluate_value(sets, x, &p)
-        }
+        eval::evaluate_along(sets, x, along, &p, grad)
     }
 }
