@@ -396,3 +396,80 @@ fn bvh_is_valid_including_duplicate_points() {
         });
     }
 }
+
+/// Far-field terms of point clouds from second moments (`eval::smooth` module docs):
+/// never above the exact value, at any opening parameter the tracer uses (the scene's,
+/// its step beta and its coarse bound steps), at any sharpness and offset, on flat,
+/// clustered and coincident points; never below the closest-box terms by more than the
+/// pruning slack, and much closer to the exact value on soft clouds.
+#[test]
+fn moment_far_fields_are_conservative_and_tighter_than_boxes() {
+    let mut rng = Rng::new(21);
+    let clouds: Vec<(&str, Vec<DVec3>)> = vec![
+        // A lidar-like ground patch with a few trees.
+        ("ground", {
+            let mut v: Vec<DVec3> = (0..4000)
+                .map(|_| DVec3::new(rng.sym(), rng.sym(), 0.01 * rng.sym()))
+                .collect();
+            v.extend((0..600).map(|i| {
+                DVec3::new(0.3 * (i % 3) as f64 - 0.3, 0.2, 0.2 * rng.next_f64()) + 0.03 * rng.vec()
+            }));
+            v
+        }),
+        // Tight clusters far from the origin, and coincident points.
+        ("clusters", {
+            let centres: Vec<DVec3> = (0..12).map(|_| rng.vec()).collect();
+            let mut v: Vec<DVec3> = (0..3000)
+                .map(|i| DVec3::splat(1e3) + centres[i % 12] + 0.02 * rng.vec())
+                .collect();
+            v.extend(std::iter::repeat_n(DVec3::splat(1e3) + centres[0], 50));
+            v
+        }),
+    ];
+    for (name, pts) in clouds {
+        let mesh = Mesh {
+            vertices: pts.iter().map(|p| p.as_vec3()).collect(),
+            segments: Vec::new(),
+            triangles: Vec::new(),
+            name: name.to_string(),
+        };
+        let set = AnySet::build(&mesh, PrimitiveKind::Points).unwrap();
+        let bounds = mesh.bounds();
+        let (centre, diag) = (bounds.center().as_dvec3(), bounds.diagonal());
+        let (mut gain, mut count) = (0.0, 0);
+        for ad in [3.0, 30.0, 300.0, 3000.0] {
+            let alpha = ad / diag;
+            for _ in 0..150 {
+                let x = centre + 0.7 * diag * rng.vec() * rng.next_f64();
+                let (exact, _, _) = brute::smooth_distance(&[&set], x, alpha, alpha);
+                let rounding = 1e-12 * s_scale(exact, alpha);
+                for beta in [0.5, 1.0, 4.0] {
+                    let p = EvalParams::new(alpha, alpha, beta);
+                    let box_p = EvalParams {
+                        moments: false,
+                        ..p
+                    };
+                    let sm = eval::evaluate_value(&[&set], x, &p).s;
+                    let sb = eval::evaluate_value(&[&set], x, &box_p).s;
+                    assert!(sm.is_finite(), "{name}: {sm} at alpha {alpha}");
+                    assert!(
+                        sm <= exact + rounding,
+                        "{name} alpha*diag {ad} beta {beta}: {sm} above the exact {exact}"
+                    );
+                    assert!(
+                        sm >= sb - 3e-10 / alpha,
+                        "{name} alpha*diag {ad} beta {beta}: {sm} below the box value {sb}"
+                    );
+                    if ad <= 30.0 && beta == 1.0 && exact - sb > 1e-6 / alpha {
+                        gain += (exact - sm) / (exact - sb);
+                        count += 1;
+                    }
+                }
+            }
+        }
+        // On soft clouds the moment terms close most of the box terms' error.
+        let mean = gain / count as f64;
+        eprintln!("{name}: moment error / box error, mean {mean:.3} over {count}");
+        assert!(count > 50 && mean < 0.5, "{name}: {mean} over {count}");
+    }
+}

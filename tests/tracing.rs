@@ -21,8 +21,9 @@ mod common;
 use glam::DVec3;
 use smoothtrace::eval::{EvalParams, brute, evaluate_value};
 use smoothtrace::render::TracerOptions;
+use smoothtrace::render::build::{BuildError, build_scene};
 use smoothtrace::render::image::Rendered;
-use smoothtrace::render::pipeline::render_scene;
+use smoothtrace::render::pipeline::{in_pool, render_built, render_scene};
 use smoothtrace::reports::compare::compare_depths;
 use smoothtrace::scene::Scene;
 use std::path::PathBuf;
@@ -253,5 +254,47 @@ fn full_bunny_edges_hit_within_a_thousandth_of_the_diagonal() {
     assert!(
         p50_plain > 2.0 * p50 && p50_plain > 1e-3,
         "scene beta alone: median {p50_plain:e}, finer hits {p50:e}"
+    );
+}
+
+/// The deer at alpha 1 (a soft cloud: far-field nodes are wide in units of 1/alpha)
+/// hits within a thousandth of the diagonal of the exact surface at the scene's beta with
+/// the moment far fields (`eval::smooth`); with the closest-box terms (the paper's) it is
+/// about 1% off.
+#[test]
+fn soft_point_clouds_hit_within_a_thousandth_with_moment_far_fields() {
+    if common::data_file("igea-points-134k.ply").is_none() {
+        eprintln!("skipping: data/igea-points-134k.ply is absent");
+        return;
+    }
+    let s = scene("deer_alpha1.toml", 160, 90);
+    let (p50, p99, only_one) = exact_vs_beta(&s);
+    eprintln!("moments: median {p50:.2e}, p99 {p99:.2e}, {only_one:.2}% one-sided");
+    assert!(p50 <= 1e-3, "median depth error {p50:e} of the diagonal");
+    let boxes = in_pool(2, || -> Result<_, BuildError> {
+        let mut built = build_scene(&s)?;
+        for o in &mut built.objects {
+            o.params.moments = false;
+        }
+        Ok(render_built(
+            &built,
+            s.render.max_steps,
+            [0; 3],
+            |o| o,
+            &|_| {},
+        ))
+    })
+    .unwrap();
+    let (_, diag, exact) = {
+        let mut e = s.clone();
+        e.render.beta = 0.0;
+        render(&e, |o| o)
+    };
+    let d = compare_depths(&boxes.depth, &exact.depth, 1.0, diag);
+    let p50_box = d.p50.unwrap();
+    eprintln!("closest-box terms: median {p50_box:.2e}");
+    assert!(
+        p50_box > 3.0 * p50 && p50_box > 1e-3,
+        "box terms: median {p50_box:e}, moments {p50:e}"
     );
 }

@@ -8,11 +8,13 @@
 
 mod bins;
 mod build;
+pub mod moments;
 mod sweep;
 mod validate;
 pub mod wide;
 
 pub use build::{BuildOptions, build, build_binary, build_binary_points, build_with};
+pub use moments::Moments4;
 pub use validate::validate;
 pub use wide::{Node4, Root};
 
@@ -64,6 +66,9 @@ pub struct Bvh {
     /// child slot (`None` when empty) and its nodes.
     pub wide_root: Option<Root>,
     pub wide: Vec<Node4>,
+    /// Second moments of each wide slot's points (`moments`; sets of points only, else
+    /// empty): the far-field bound of point clouds.
+    pub moments: Vec<Moments4>,
 }
 
 impl Bvh {
@@ -99,6 +104,7 @@ impl Bvh {
     pub fn memory_bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<Node>()
             + self.wide.len() * std::mem::size_of::<Node4>()
+            + self.moments.len() * std::mem::size_of::<Moments4>()
             + self.order.len() * 4
     }
 }

@@ -6,8 +6,9 @@
 //! primitives) or opened.
 
 use super::smooth::{EvalParams, EvalStats, Sink};
-use crate::bvh::Node4;
+use crate::bvh::moments::{MIDDLE, lin_bound};
 use crate::bvh::wide::{EMPTY, Root};
+use crate::bvh::{Moments4, Node4};
 use crate::primitives::{Primitive, PrimitiveSet, WeightScale};
 use glam::DVec3;
 
@@ -86,6 +87,11 @@ impl Open {
     }
 }
 
+/// Far-field terms whose closest-box value is below `exp(-SIGNIFICANT)` of the nearest
+/// distance's term take the closest-box form even when moments are kept: their share of
+/// the sum is too small for the tighter bound to move `s`.
+const SIGNIFICANT: f64 = 2.0;
+
 /// One walk over one set at `x`: its decisions go to the sink and the statistics.
 pub(super) struct Walk<'w, 'a, P, const GRAD: bool, const SLOPE: bool> {
     set: &'w PrimitiveSet<P>,
@@ -100,6 +106,8 @@ pub(super) struct Walk<'w, 'a, P, const GRAD: bool, const SLOPE: bool> {
     beta2: f64,
     /// Weight of a far-field term per primitive.
     w_ff: f64,
+    /// Second moments per wide node, when far fields use them (points).
+    moments: &'w [Moments4],
 }
 
 impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, GRAD, SLOPE> {
@@ -125,6 +133,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             inv_alpha: 1.0 / p.alpha,
             beta2: if p.beta > 0.0 { p.beta * p.beta } else { -1.0 },
             w_ff: scale.max_weight(),
+            moments: if p.moments { &set.bvh.moments } else { &[] },
         }
     }
 
@@ -143,7 +152,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
     }
 
     /// A whole walk from the root.
-    pub fn from_root(&mut self) {
+    pub fn run(&mut self) {
         let Some(root) = self.set.bvh.wide_root else {
             return;
         };
@@ -194,7 +203,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             let d2 = child_distances2(node, self.x);
             let mut open = Open::new();
             for j in 0..2 {
-                self.middle(node, j, &d2, reach2, &mut open);
+                self.middle(node, e.i, j, &d2, reach2, &mut open);
             }
             self.push(node, &open);
         }
@@ -215,7 +224,15 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
     /// distance of its nearer child box (a lower bound of every distance below it), or
     /// its two slots one by one.
     #[inline(always)]
-    fn middle(&mut self, node: &Node4, j: usize, d2: &[f64; 4], reach2: f64, open: &mut Open) {
+    fn middle(
+        &mut self,
+        node: &Node4,
+        i: u32,
+        j: usize,
+        d2: &[f64; 4],
+        reach2: f64,
+        open: &mut Open,
+    ) {
         let near = if d2[2 * j] <= d2[2 * j + 1] {
             2 * j
         } else {
@@ -227,21 +244,83 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             return;
         }
         if self.far_ok(node.mid_diam2[j], r2m) {
-            let (min, max) = slot_box(node, near);
-            let w = node.mid_size[j] as f64 * self.w_ff;
-            self.sink.far(self.x, r2m, w, min, max);
-            self.stats.far += 1;
+            // (A middle that is a leaf in its slot has an infinite diameter.)
+            self.far_middle(node, i, j, (near, r2m));
             return;
         }
         for k in [2 * j, 2 * j + 1] {
-            self.slot(node, k, d2[k], reach2, open);
+            self.slot(node, i, k, d2[k], reach2, open);
+        }
+    }
+
+    /// The far-field term of slot `k` of wide node `i` at squared distance `d2k > 0`.
+    #[inline(always)]
+    fn far_slot(&mut self, node: &Node4, i: u32, k: usize, d2k: f64) {
+        let bx = slot_box(node, k);
+        let w = node.size[k] as f64 * self.w_ff;
+        self.far_entry(i, k, bx, w, (d2k, bx));
+    }
+
+    /// The far-field term of middle `j` of wide node `i` (both slots in use), its nearer
+    /// slot `near` at squared distance `r2m > 0`.
+    #[inline(always)]
+    fn far_middle(&mut self, node: &Node4, i: u32, j: usize, (near, r2m): (usize, f64)) {
+        let near_box = slot_box(node, near);
+        let w = node.mid_size[j] as f64 * self.w_ff;
+        let (b1, b2) = (slot_box(node, 2 * j), slot_box(node, 2 * j + 1));
+        let bx = (b1.0.min(b2.0), b1.1.max(b2.1));
+        self.far_entry(i, MIDDLE + j, bx, w, (r2m, near_box));
+    }
+
+    /// A far-field term of weight `w` for entry `e` of wide node `i`'s moments (box
+    /// `bx`): from its second moments if kept, else the closest-box term of `near`.
+    #[inline(always)]
+    fn far_entry(
+        &mut self,
+        i: u32,
+        e: usize,
+        bx: (DVec3, DVec3),
+        w: f64,
+        near: (f64, (DVec3, DVec3)),
+    ) {
+        self.stats.far += 1;
+        // Moment terms only where the term can matter: within `SIGNIFICANT` (in units
+        // of alpha times distance) of the nearest distance seen, counting its weight.
+        let ln_w = (((w.to_bits() >> 52) & 0x7ff) as f64 - 1022.0) * std::f64::consts::LN_2;
+        let reach = self.sink.acc.m + (SIGNIFICANT + ln_w.max(0.0)) * self.inv_alpha;
+        match self
+            .moments
+            .get(i as usize)
+            .filter(|_| near.0 < reach * reach)
+        {
+            Some(m) => {
+                let crel = [m.c[0][e], m.c[1][e], m.c[2][e]];
+                let c = bx.0 + DVec3::new(crel[0] as f64, crel[1] as f64, crel[2] as f64);
+                let mm = [
+                    m.m[0][e] as f64,
+                    m.m[1][e] as f64,
+                    m.m[2][e] as f64,
+                    m.m[3][e] as f64,
+                    m.m[4][e] as f64,
+                    m.m[5][e] as f64,
+                ];
+                let sigma2 = |u: DVec3| {
+                    mm[0] * u.x * u.x
+                        + mm[1] * u.y * u.y
+                        + mm[2] * u.z * u.z
+                        + 2.0 * (mm[3] * u.x * u.y + mm[4] * u.x * u.z + mm[5] * u.y * u.z)
+                };
+                let lin = lin_bound(crel, c);
+                self.sink.far_moments(self.x, w, bx, c, sigma2, lin, near);
+            }
+            None => self.sink.far(self.x, near.0, w, near.1.0, near.1.1),
         }
     }
 
     /// Decides slot `k` of wide node `i` at squared distance `d2k`: pruned, far field,
     /// or to be opened (leaves too: they are summed when popped).
     #[inline(always)]
-    fn slot(&mut self, node: &Node4, k: usize, d2k: f64, reach2: f64, open: &mut Open) {
+    fn slot(&mut self, node: &Node4, i: u32, k: usize, d2k: f64, reach2: f64, open: &mut Open) {
         let c = node.count[k];
         if c == EMPTY {
             return;
@@ -251,10 +330,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             return;
         }
         if c == 0 && self.far_ok(node.diam2[k], d2k) {
-            let (min, max) = slot_box(node, k);
-            let w = node.size[k] as f64 * self.w_ff;
-            self.sink.far(self.x, d2k, w, min, max);
-            self.stats.far += 1;
+            self.far_slot(node, i, k, d2k);
             return;
         }
         open.insert(d2k, k);

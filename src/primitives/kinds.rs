@@ -24,6 +24,9 @@ pub struct Term {
 
 /// What the BVH and the evaluator need of a primitive.
 pub trait Primitive: Copy + Send + Sync + 'static {
+    /// A point (its centroid): its set keeps second moments for the far field
+    /// (`bvh::moments`).
+    const IS_POINT: bool = false;
     fn bounds(&self) -> Aabb;
     fn centroid(&self) -> Vec3;
     fn closest_point(&self, x: DVec3) -> DVec3;
@@ -57,6 +60,7 @@ pub struct Point {
 }
 
 impl Primitive for Point {
+    const IS_POINT: bool = true;
     fn bounds(&self) -> Aabb {
         Aabb {
             min: self.p,

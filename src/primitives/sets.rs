@@ -91,6 +91,9 @@ impl<P: Primitive> PrimitiveSet<P> {
             || bvh.make_wide(),
         );
         bvh.order = order;
+        if P::IS_POINT {
+            bvh.moments = bvh::moments::build(&bvh.wide, |i| sorted[i].centroid());
+        }
         let bounds = bvh
             .nodes
             .first()

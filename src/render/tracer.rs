@@ -26,7 +26,7 @@
 //! 7. The normal is the normalised gradient at the hit. Steps need only the value, so
 //!    they use value-only evaluations; an evaluation predicted to hit (its predecessor's
 //!    value within two epsilons, or a linear extrapolation of the last two values
-//!    within one) carries the gradient, so most hits need no second traversal.
+//!    within two) carries the gradient, so most hits need no second traversal.
 //! 8. Steps are over-relaxed (`Stepper`): up to `2 s / (1 + k)` for a slope `k` of the
 //!    field along the ray, kept only when the next sample's ball closes the gap, else
 //!    the ray returns to the plain step. Same surface, fewer steps at grazing incidence.
@@ -39,9 +39,13 @@
 //!    the finer beta (still a lower bound, so the step that got there stays safe); from
 //!    the first such evaluation on, the ray's full evaluations stay fine. Steps far from
 //!    the surface keep the scene's beta, where accuracy only shortens a step a little.
-//!    Objects made of points alone keep the scene's beta for hits too: on the bunny's
-//!    points the error is already 0.02% of the diagonal, and on soft clouds (the deer
-//!    at alpha 1, 1% of the diagonal) a finer hit beta costs 1.9x the leaves for 0.6%.
+//!    Objects made of points alone keep the scene's beta for hits: their far-field
+//!    terms come from second moments (`eval::smooth`), within 0.07% of the diagonal of
+//!    the exact surface even on the deer at alpha 1 (1% with the closest-box terms).
+//! 10. On point clouds, full evaluations that only take a step (not predicted to hit)
+//!     are made at the coarser `TracerOptions::step_beta` (1 by default): a lower bound
+//!     too, so the step is safe, at 60-75% of the terms near the surface; a value in
+//!     the hit band or below is taken again at the hit beta before it decides anything.
 
 use super::object::TraceObject;
 use crate::eval::EvalStats;
@@ -69,6 +73,11 @@ pub struct TracerOptions {
     /// Hits on objects with edges or triangles are decided at this share of the scene's
     /// beta (module docs, item 9); 1 decides them at the scene's beta (the paper's).
     pub hit_beta_scale: f64,
+    /// Full evaluations that only take a step (not predicted to hit) are made at this
+    /// opening parameter when it is coarser than the scene's (0 = the scene's beta):
+    /// still a lower bound, so the step is safe, at a fraction of the terms. Any value in
+    /// the hit band or below is taken again at the hit beta before it decides anything.
+    pub step_beta: f64,
     /// Steps by the free distance along the ray from the terms' slopes (`eval::reach`;
     /// objects of points only), at least the plain step.
     pub reach_steps: bool,
@@ -99,6 +108,7 @@ impl TracerOptions {
             cone: true,
             relax: true,
             hit_beta_scale: 0.6,
+            step_beta: 1.0,
             reach_steps: true,
             clip: true,
             backtrack: Backtrack::Illinois,
@@ -114,6 +124,7 @@ impl TracerOptions {
             cone: false,
             relax: false,
             hit_beta_scale: 1.0,
+            step_beta: 0.0,
             reach_steps: false,
             clip: false,
             backtrack: Backtrack::FixedStep,
@@ -196,8 +207,14 @@ pub struct Tracer<'a> {
     tolerance: Vec<f64>,
     /// Opening parameter per object of the evaluations that decide hits (item 9).
     hit_beta: Vec<f64>,
+    /// Opening parameter per object of the full evaluations that only take a step.
+    step_beta: Vec<f64>,
     /// Some object decides hits at a finer beta than its steps.
     refine: bool,
+    /// Some object decides hits at a finer beta than the scene's (edges, triangles): from
+    /// the first evaluation at the hit beta on, the ray's full evaluations stay there
+    /// (the scene's beta is several epsilons low near their surfaces, item 9).
+    sticky: bool,
     /// Union of the grown object boxes.
     min: DVec3,
     max: DVec3,
@@ -230,17 +247,33 @@ impl<'a> Tracer<'a> {
                 o.params.beta * scale.clamp(0.0, 1.0)
             })
             .collect();
-        let refine = objects
+        // Coarser steps pay on point clouds only (on edges and triangles the scene's beta
+        // is already several epsilons low near the surface, item 9).
+        let step_beta: Vec<f64> = objects
+            .iter()
+            .map(|o| {
+                let points_only = o.sets.iter().all(|s| matches!(s, AnySet::Points(_)));
+                if points_only {
+                    o.params.beta.max(options.step_beta)
+                } else {
+                    o.params.beta
+                }
+            })
+            .collect();
+        let refine = step_beta.iter().zip(&hit_beta).any(|(s, h)| s != h);
+        let sticky = objects
             .iter()
             .zip(&hit_beta)
-            .any(|(o, &b)| b != o.params.beta);
+            .any(|(o, &h)| h < o.params.beta);
         Tracer {
             objects,
             sets: objects.iter().map(|o| o.set_refs()).collect(),
             reach,
             tolerance,
             hit_beta,
+            step_beta,
             refine,
+            sticky,
             min,
             max,
             options,
@@ -325,7 +358,7 @@ impl<'a> Tracer<'a> {
                 let beta = match coarse {
                     Some(b) => b.max(obj.params.beta),
                     None if accurate => self.hit_beta[k],
-                    None => obj.params.beta,
+                    None => self.step_beta[k],
                 };
                 let sample = obj.evaluate(
                     &self.sets[k],
@@ -442,9 +475,11 @@ impl<'a> Tracer<'a> {
                     want = Want::Gradient;
                 }
             }
-            accurate |= refine && want == Want::Gradient;
+            // An evaluation predicted to hit is made at the hit beta.
+            let fine = accurate || (refine && want == Want::Gradient);
+            accurate |= fine && self.sticky;
             let along = self.options.reach_steps.then_some((d, t_max - t));
-            let mut f = self.sample(x, &mut stats, want, accurate, along);
+            let mut f = self.sample(x, &mut stats, want, fine, along);
             if let Some(back) = stepper.uncovered(prev, t, f.s) {
                 // An over-relaxed step left a gap: go back to the plain step's end.
                 stats.rejected_steps += 1;
@@ -452,7 +487,7 @@ impl<'a> Tracer<'a> {
                 want = Want::Value;
                 continue;
             }
-            if refine && !accurate && f.s <= eps {
+            if refine && !fine && f.s <= eps {
                 // In the hit band or below at the scene's beta: decide at the hit beta
                 // (a lower bound too, so the step that got here stays safe).
                 accurate = true;
@@ -481,7 +516,7 @@ impl<'a> Tracer<'a> {
             let step = stepper.step(prev, t, f.s, f.reach, Kind::Full);
             // The value at the next sample, if the field keeps its slope along the ray.
             let predicted = f.s - stepper.slope * step;
-            want = if predicted <= eps || f.s <= 2.0 * eps {
+            want = if predicted <= 2.0 * eps || f.s <= 2.0 * eps {
                 Want::Gradient
             } else {
                 Want::Value

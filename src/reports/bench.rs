@@ -289,6 +289,7 @@ fn run_row(
             for o in &mut built.objects {
                 o.params.accumulation = Accumulation::Naive;
                 o.params.prune = false;
+                o.params.moments = false;
             }
             let camera = scene.camera.build(w, h).map_err(|source| {
                 crate::render::build::BuildError::Camera {

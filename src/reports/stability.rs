@@ -107,6 +107,7 @@ impl Evaluator {
         if self == Evaluator::Naive {
             p.accumulation = Accumulation::Naive;
             p.prune = false;
+            p.moments = false;
         }
         p
     }

@@ -198,6 +198,7 @@ pub fn run(
                         Accumulation::Stable
                     };
                     obj.params.prune = !o.paper_mode;
+                    obj.params.moments = !o.paper_mode;
                 }
                 let options = if o.paper_mode {
                     TracerOptions::paper(built.epsilon, scene.render.max_steps)
