@@ -98,7 +98,11 @@ fn f32_up(v: f64) -> f32 {
 /// a node's subtree occupies the indices from it to its next sibling's), for the points
 /// in leaf order (`point(i)` is the `i`-th).
 pub fn build(wide: &[Node4], point: impl Fn(usize) -> Vec3 + Sync) -> Vec<Moments4> {
-    let mut out = vec![Moments4::default(); wide.len()];
+    // Zeroed in parallel: the pages are touched by both threads at once.
+    let mut out: Vec<Moments4> = (0..wide.len())
+        .into_par_iter()
+        .map(|_| Moments4::default())
+        .collect();
     if !wide.is_empty() {
         node(wide, &point, 0, &mut out, 0);
     }
@@ -118,30 +122,35 @@ fn node(
     let end_all = i + out.len();
     let (here, mut rest) = out.split_first_mut().expect("a slot per node");
     // Inner children own consecutive ranges of `rest`, in slot order.
-    let mut jobs: Vec<(usize, usize, &mut [Moments4])> = Vec::new();
-    let inner: Vec<usize> = (0..4).filter(|&k| w.count[k] == 0).collect();
-    for (h, &k) in inner.iter().enumerate() {
-        let start = w.child[k] as usize;
-        let end = inner
-            .get(h + 1)
-            .map(|&k2| w.child[k2] as usize)
+    let mut parts: [Option<&mut [Moments4]>; 4] = [None, None, None, None];
+    for k in 0..4 {
+        if w.count[k] != 0 {
+            continue;
+        }
+        let end = (k + 1..4)
+            .find(|&k2| w.count[k2] == 0)
+            .map(|k2| w.child[k2] as usize)
             .unwrap_or(end_all);
-        let (head, tail) = std::mem::take(&mut rest).split_at_mut(end - start);
-        jobs.push((k, start, head));
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(end - w.child[k] as usize);
+        parts[k] = Some(head);
         rest = tail;
     }
-    let children: Vec<(usize, Stats)> = if depth < 8 {
-        jobs.into_par_iter()
-            .map(|(k, c, o)| (k, node(wide, point, c, o, depth + 1)))
-            .collect()
-    } else {
-        jobs.into_iter()
-            .map(|(k, c, o)| (k, node(wide, point, c, o, depth + 1)))
-            .collect()
-    };
     let mut slots = [Stats::default(); 4];
-    for (k, s) in children {
-        slots[k] = s;
+    let run = |k: usize, o: &mut [Moments4]| node(wide, point, w.child[k] as usize, o, depth + 1);
+    if depth < 6 {
+        rayon::scope(|scope| {
+            for ((k, part), slot) in parts.iter_mut().enumerate().zip(slots.iter_mut()) {
+                if let Some(o) = part.take() {
+                    scope.spawn(move |_| *slot = run(k, o));
+                }
+            }
+        });
+    } else {
+        for ((k, part), slot) in parts.iter_mut().enumerate().zip(slots.iter_mut()) {
+            if let Some(o) = part.take() {
+                *slot = run(k, o);
+            }
+        }
     }
     for (k, slot) in slots.iter_mut().enumerate() {
         let c = w.count[k];
@@ -178,7 +187,8 @@ fn store(m: &mut Moments4, k: usize, min: DVec3, s: &Stats) {
     let rel = s.mean - min;
     let crel = [rel.x as f32, rel.y as f32, rel.z as f32];
     let c = min + DVec3::new(crel[0] as f64, crel[1] as f64, crel[2] as f64);
-    let mut second = s.scatter.map(|v| v / s.n);
+    let inv_n = 1.0 / s.n;
+    let mut second = s.scatter.map(|v| v * inv_n);
     add_outer(&mut second, s.mean - c, 1.0);
     let pad = 4e-7 * (second[0] + second[1] + second[2]);
     for a in 0..3 {
