@@ -254,6 +254,7 @@ fn main() {
                         tol,
                         false,
                         None,
+                        false,
                     );
                     let st = e.stats;
                     sum[0] += st.exact as f64;

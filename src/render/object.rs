@@ -62,7 +62,8 @@ impl TraceObject {
     /// bound steps take a coarser one, a lower bound of the scene's sum; its hit
     /// decisions a finer one) and the pruning tolerance possibly raised (a lower bound
     /// too, see `eval::smooth`), with the gradient if `grad`, and with the free distance
-    /// along a ray `(u, max_len)` if `along` is given (`eval::reach`).
+    /// along a ray `(u, max_len)` if `along` is given (`eval::reach`); with closest-box
+    /// far fields if `bound` (a bound step).
     #[allow(clippy::too_many_arguments)]
     pub fn evaluate(
         &self,
@@ -73,11 +74,15 @@ impl TraceObject {
         prune_tolerance: f64,
         grad: bool,
         along: Option<(DVec3, f64)>,
+        bound: bool,
     ) -> Sample {
         let mut p = self.params;
         p.alpha = alpha;
         p.beta = beta;
         p.prune_tolerance = p.prune_tolerance.max(prune_tolerance);
+        // Bound steps take closest-box far fields: the moment terms do not lengthen them
+        // (same steps on the deer and the lidar, measured) and cost 10-13% of the trace.
+        p.moments &= !bound;
         eval::evaluate_along(sets, x, along, &p, grad)
     }
 }

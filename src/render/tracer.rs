@@ -316,6 +316,7 @@ impl<'a> Tracer<'a> {
                 self.tolerance[k],
                 true,
                 None,
+                false,
             );
             stats.evals += 1;
             stats.eval.add(&sample.stats);
@@ -368,6 +369,7 @@ impl<'a> Tracer<'a> {
                     self.tolerance[k],
                     grad,
                     along,
+                    coarse.is_some(),
                 );
                 if coarse.is_some() {
                     stats.coarse_evals += 1;
