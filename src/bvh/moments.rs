@@ -123,7 +123,7 @@ fn node(
     let (here, mut rest) = out.split_first_mut().expect("a slot per node");
     // Inner children own consecutive ranges of `rest`, in slot order.
     let mut parts: [Option<&mut [Moments4]>; 4] = [None, None, None, None];
-    for k in 0..4 {
+    for (k, part) in parts.iter_mut().enumerate() {
         if w.count[k] != 0 {
             continue;
         }
@@ -132,7 +132,7 @@ fn node(
             .map(|k2| w.child[k2] as usize)
             .unwrap_or(end_all);
         let (head, tail) = std::mem::take(&mut rest).split_at_mut(end - w.child[k] as usize);
-        parts[k] = Some(head);
+        *part = Some(head);
         rest = tail;
     }
     let mut slots = [Stats::default(); 4];
