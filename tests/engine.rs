@@ -401,7 +401,9 @@ fn bvh_is_valid_including_duplicate_points() {
 /// never above the exact value, at any opening parameter the tracer uses (the scene's,
 /// its step beta and its coarse bound steps), at any sharpness and offset, on flat,
 /// clustered and coincident points; never below the closest-box terms by more than the
-/// pruning slack, and much closer to the exact value on soft clouds.
+/// pruning slack, and much closer to the exact value on soft clouds. The free distance
+/// along a ray (`eval::reach`) keeps the exact value positive (this found middles' slopes
+/// taken from the nearer child's box alone, wrong at beta 4).
 #[test]
 fn moment_far_fields_are_conservative_and_tighter_than_boxes() {
     let mut rng = Rng::new(21);
@@ -460,6 +462,22 @@ fn moment_far_fields_are_conservative_and_tighter_than_boxes() {
                         sm >= sb - 3e-10 / alpha,
                         "{name} alpha*diag {ad} beta {beta}: {sm} below the box value {sb}"
                     );
+                    // The free distance along a ray (eval::reach) holds with moment terms:
+                    // the exact value stays positive over it.
+                    let u = rng.unit();
+                    let r = eval::evaluate_reach(&[&set], x, u, &p, diag, false);
+                    if exact > 0.0 && r.reach > r.s {
+                        for k in 1..=8 {
+                            let t = r.reach * k as f64 / 8.0;
+                            let (e, _, _) =
+                                brute::smooth_distance(&[&set], x + t * u, alpha, alpha);
+                            assert!(
+                                e >= -1e-12 * s_scale(e, alpha),
+                                "{name} alpha*diag {ad} beta {beta}: exact {e} at {t} of free {}",
+                                r.reach
+                            );
+                        }
+                    }
                     if ad <= 30.0 && beta == 1.0 && exact - sb > 1e-6 / alpha {
                         gain += (exact - sm) / (exact - sb);
                         count += 1;

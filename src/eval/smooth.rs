@@ -294,20 +294,38 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
     }
 
     /// The far-field term of a subtree with box `min..max` at squared distance `r2 > 0`.
+    /// A middle (`other` = its farther child's box, the term at the nearer one's
+    /// distance) takes the smaller of the two boxes' slopes along the ray: each child's
+    /// distance is at least its own box's linear bound, and the nearer box's distance at
+    /// the sample is the smaller, so that line bounds both ahead (`eval::reach`).
     #[inline]
-    pub fn far(&mut self, x: DVec3, r2: f64, weight: f64, min: DVec3, max: DVec3) {
+    pub fn far(
+        &mut self,
+        x: DVec3,
+        r2: f64,
+        weight: f64,
+        (min, max): (DVec3, DVec3),
+        other: Option<(DVec3, DVec3)>,
+    ) {
         let r = r2.sqrt();
         let m = self.acc.m;
+        let slope_other = |u: DVec3| {
+            other.map_or(1.0, |(lo, hi)| {
+                let v = x - x.clamp(lo, hi);
+                let d = v.length();
+                if d > 0.0 { v.dot(u) / d } else { -1.0 }
+            })
+        };
         if GRAD {
             let dir = (x - x.clamp(min, max)) / r;
             let e = self.acc.add(r, weight, dir, DVec3::ZERO);
             if SLOPE {
-                self.add_slope(m, e, dir.dot(self.u));
+                self.add_slope(m, e, dir.dot(self.u).min(slope_other(self.u)));
             }
         } else if SLOPE {
             let a = (x - x.clamp(min, max)).dot(self.u) / r;
             let e = self.acc.add_value(r, weight);
-            self.add_slope(m, e, a);
+            self.add_slope(m, e, a.min(slope_other(self.u)));
         } else {
             self.acc.add_value(r, weight);
         }
@@ -315,7 +333,8 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
 
     /// The far-field term of a subtree of `n` points of weight at most `w` (`weight =
     /// n w`) in the box `bx` at squared distance `r2 > 0` from `x` (closest-box term in
-    /// `near`, its squared distance `r2` and box), from their second moment about the
+    /// `near`: its squared distance, box and, for a middle, the farther child's box),
+    /// from their second moment about the
     /// reference point `c` (`sigma2(u) >= u^T M u`) whose distance to their mean is at
     /// most `lin` (module docs): the moment bound where it is below the box term.
     #[allow(clippy::too_many_arguments)]
@@ -328,7 +347,7 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
         c: DVec3,
         sigma2: impl Fn(DVec3) -> f64,
         lin: f64,
-        (r2, near): (f64, (DVec3, DVec3)),
+        (r2, near, other): (f64, (DVec3, DVec3), Option<(DVec3, DVec3)>),
     ) {
         let v = x - c;
         let l2 = v.length_squared();
@@ -348,7 +367,7 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
                 return;
             }
         }
-        self.far(x, r2, weight, near.0, near.1);
+        self.far(x, r2, weight, near, other);
     }
 
     /// A far-field term at distance `d` with unit direction `dir` (the gradient of `d`,

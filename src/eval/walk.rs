@@ -168,7 +168,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         let r2 = (x - x.clamp(rmin, rmax)).length_squared();
         if root.count == 0 && self.far_ok(root.diam2, r2) {
             self.sink
-                .far(x, r2, root.size as f64 * self.w_ff, rmin, rmax);
+                .far(x, r2, root.size as f64 * self.w_ff, (rmin, rmax), None);
             self.stats.far += 1;
             return;
         }
@@ -258,7 +258,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
     fn far_slot(&mut self, node: &Node4, i: u32, k: usize, d2k: f64) {
         let bx = slot_box(node, k);
         let w = node.size[k] as f64 * self.w_ff;
-        self.far_entry(i, k, bx, w, (d2k, bx));
+        self.far_entry(i, k, bx, w, (d2k, bx, None));
     }
 
     /// The far-field term of middle `j` of wide node `i` (both slots in use), its nearer
@@ -269,7 +269,8 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         let w = node.mid_size[j] as f64 * self.w_ff;
         let (b1, b2) = (slot_box(node, 2 * j), slot_box(node, 2 * j + 1));
         let bx = (b1.0.min(b2.0), b1.1.max(b2.1));
-        self.far_entry(i, MIDDLE + j, bx, w, (r2m, near_box));
+        let other = slot_box(node, 4 * j + 1 - near);
+        self.far_entry(i, MIDDLE + j, bx, w, (r2m, near_box, Some(other)));
     }
 
     /// A far-field term of weight `w` for entry `e` of wide node `i`'s moments (box
@@ -281,7 +282,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         e: usize,
         bx: (DVec3, DVec3),
         w: f64,
-        near: (f64, (DVec3, DVec3)),
+        near: (f64, (DVec3, DVec3), Option<(DVec3, DVec3)>),
     ) {
         self.stats.far += 1;
         // Moment terms only where the term can matter: within `SIGNIFICANT` (in units
@@ -313,7 +314,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
                 let lin = lin_bound(crel, c);
                 self.sink.far_moments(self.x, w, bx, c, sigma2, lin, near);
             }
-            None => self.sink.far(self.x, near.0, w, near.1.0, near.1.1),
+            None => self.sink.far(self.x, near.0, w, near.1, near.2),
         }
     }
 
