@@ -37,7 +37,7 @@
 //!    stops where it drops below epsilon stops short of the exact surface. Evaluations
 //!    predicted to hit, and any whose value falls in the hit band or below, are taken at
 //!    the finer beta (still a lower bound, so the step that got there stays safe); from
-//!    the first such evaluation on, the ray's full evaluations stay fine. Steps far from
+//!    the first such evaluation on, the ray's full evaluations stay fine (`sticky`). Steps far from
 //!    the surface keep the scene's beta, where accuracy only shortens a step a little.
 //!    Objects made of points alone keep the scene's beta for hits: their far-field
 //!    terms come from second moments (`eval::smooth`), within 0.07% of the diagonal of
