@@ -29,6 +29,15 @@ pub struct Moments4 {
 /// Index of middle `j`'s entry in a [`Moments4`].
 pub const MIDDLE: usize = 4;
 
+/// `u^T M u` for a second moment `m` stored as xx, yy, zz, xy, xz, yz.
+#[inline]
+pub fn quadratic_form(m: &[f64; 6], u: DVec3) -> f64 {
+    m[0] * u.x * u.x
+        + m[1] * u.y * u.y
+        + m[2] * u.z * u.z
+        + 2.0 * (m[3] * u.x * u.y + m[4] * u.x * u.z + m[5] * u.y * u.z)
+}
+
 /// A bound of the distance from the reference point `c` (stored as `crel` from its
 /// box's min corner) to the points' mean: the f32 rounding of `crel` (at most `2^-24`
 /// of each component) and the f64 rounding of the mean.
@@ -265,10 +274,7 @@ mod tests {
                             .sum::<f64>()
                             / below.len() as f64;
                         let mm = m.m.map(|r| r[e] as f64);
-                        let stored = mm[0] * u.x * u.x
-                            + mm[1] * u.y * u.y
-                            + mm[2] * u.z * u.z
-                            + 2.0 * (mm[3] * u.x * u.y + mm[4] * u.x * u.z + mm[5] * u.y * u.z);
+                        let stored = quadratic_form(&mm, u);
                         assert!(
                             stored >= exact,
                             "n {n} node {i} entry {e}: {stored} < {exact}"

@@ -6,7 +6,7 @@
 //! primitives) or opened.
 
 use super::smooth::{EvalParams, EvalStats, Sink};
-use crate::bvh::moments::{MIDDLE, lin_bound};
+use crate::bvh::moments::{MIDDLE, lin_bound, quadratic_form};
 use crate::bvh::wide::{EMPTY, Root};
 use crate::bvh::{Moments4, Node4};
 use crate::primitives::{Primitive, PrimitiveSet, WeightScale};
@@ -265,11 +265,10 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
     /// slot `near` at squared distance `r2m > 0`.
     #[inline(always)]
     fn far_middle(&mut self, node: &Node4, i: u32, j: usize, (near, r2m): (usize, f64)) {
-        let near_box = slot_box(node, near);
         let w = node.mid_size[j] as f64 * self.w_ff;
         let (b1, b2) = (slot_box(node, 2 * j), slot_box(node, 2 * j + 1));
         let bx = (b1.0.min(b2.0), b1.1.max(b2.1));
-        let other = slot_box(node, 4 * j + 1 - near);
+        let (near_box, other) = if near == 2 * j { (b1, b2) } else { (b2, b1) };
         self.far_entry(i, MIDDLE + j, bx, w, (r2m, near_box, Some(other)));
     }
 
@@ -305,12 +304,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
                     m.m[4][e] as f64,
                     m.m[5][e] as f64,
                 ];
-                let sigma2 = |u: DVec3| {
-                    mm[0] * u.x * u.x
-                        + mm[1] * u.y * u.y
-                        + mm[2] * u.z * u.z
-                        + 2.0 * (mm[3] * u.x * u.y + mm[4] * u.x * u.z + mm[5] * u.y * u.z)
-                };
+                let sigma2 = |u: DVec3| quadratic_form(&mm, u);
                 let lin = lin_bound(crel, c);
                 self.sink.far_moments(self.x, w, bx, c, sigma2, lin, near);
             }
