@@ -187,6 +187,89 @@ fn pruning_off_gives_the_same_values() {
     }
 }
 
+/// Pruning at the tracer's tolerances (up to 1e-2 of the sum), where the budget rule
+/// skips whole subtrees (`eval::smooth` module docs): never above the exact value, never
+/// more than `2 tol / alpha` below it at beta 0 (pruning alone), with the free distance
+/// along a ray keeping the exact value positive; and with far fields (beta 1), fewer
+/// leaves than the union-bound rule alone visits at the same tolerance.
+#[test]
+fn budget_pruning_is_conservative_and_within_its_tolerance() {
+    let mut rng = Rng::new(31);
+    // A lidar-like ground patch with trees: many primitives within the pruning reach.
+    let mut pts: Vec<DVec3> = (0..20_000)
+        .map(|_| DVec3::new(rng.sym(), rng.sym(), 0.005 * rng.sym()))
+        .collect();
+    pts.extend((0..2000).map(|i| {
+        DVec3::new(0.25 * (i % 5) as f64 - 0.5, 0.1, 0.15 * rng.next_f64()) + 0.02 * rng.vec()
+    }));
+    let mesh = Mesh {
+        vertices: pts.iter().map(|p| p.as_vec3()).collect(),
+        segments: Vec::new(),
+        triangles: Vec::new(),
+        name: "ground".to_string(),
+    };
+    let set = AnySet::build(&mesh, PrimitiveKind::Points).unwrap();
+    let diag = mesh.bounds().diagonal();
+    let (mut leaves_union, mut leaves_budget) = (0u64, 0u64);
+    for ad in [100.0, 300.0, 1000.0] {
+        let alpha = ad / diag;
+        for _ in 0..60 {
+            let x = DVec3::new(0.8 * rng.sym(), 0.8 * rng.sym(), 0.2 * rng.next_f64());
+            let (exact, _, _) = brute::smooth_distance(&[&set], x, alpha, alpha);
+            let rounding = 1e-12 * s_scale(exact, alpha);
+            for tol in [1e-3, 1e-2] {
+                let p = EvalParams {
+                    prune_tolerance: tol,
+                    ..EvalParams::new(alpha, alpha, 0.0)
+                };
+                let got = eval::evaluate(&[&set], x, &p);
+                // With far fields (the tracer's step beta), against the first rule alone.
+                let far = EvalParams { beta: 1.0, ..p };
+                let union_only = EvalParams {
+                    budget: false,
+                    ..far
+                };
+                let with_far = eval::evaluate_value(&[&set], x, &far);
+                assert!(
+                    with_far.s <= exact + rounding,
+                    "alpha*diag {ad} tol {tol} beta 1: {} above the exact {exact}",
+                    with_far.s
+                );
+                leaves_budget += with_far.stats.leaves() as u64;
+                leaves_union += eval::evaluate_value(&[&set], x, &union_only).stats.leaves() as u64;
+                assert!(
+                    got.s <= exact + rounding,
+                    "alpha*diag {ad} tol {tol}: {} above the exact {exact} at {x}",
+                    got.s
+                );
+                assert!(
+                    got.s >= exact - 2.0 * tol / alpha - rounding,
+                    "alpha*diag {ad} tol {tol}: {} more than 2 tol / alpha below {exact}",
+                    got.s
+                );
+                let u = rng.unit();
+                let r = eval::evaluate_reach(&[&set], x, u, &p, diag, false);
+                if exact > 0.0 {
+                    for k in 1..=8 {
+                        let y = x + u * (r.reach * k as f64 / 8.0);
+                        let (e, _, _) = brute::smooth_distance(&[&set], y, alpha, alpha);
+                        assert!(
+                            e > -rounding,
+                            "alpha*diag {ad} tol {tol}: exact {e} < 0 within the free distance {} (s {})",
+                            r.reach,
+                            r.s
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        leaves_budget * 20 < leaves_union * 19,
+        "{leaves_budget} leaves with the budget against {leaves_union} without"
+    );
+}
+
 #[test]
 fn nesting_in_alpha_with_unit_weights() {
     let sphere = bumpy_sphere(10, 16);

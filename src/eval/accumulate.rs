@@ -32,6 +32,9 @@ pub struct Accumulator {
     g: DVec3,
     naive_s: f64,
     naive_g: DVec3,
+    /// Upper bound of the shifted mass of subtrees pruned against the budget (added to
+    /// the sum at the end, so `s` stays a lower bound).
+    pub pruned: f64,
 }
 
 impl Accumulator {
@@ -44,6 +47,7 @@ impl Accumulator {
             g: DVec3::ZERO,
             naive_s: 0.0,
             naive_g: DVec3::ZERO,
+            pruned: 0.0,
         }
     }
 
@@ -58,6 +62,7 @@ impl Accumulator {
             let rescale = (-self.alpha * (self.m - d)).exp();
             self.s *= rescale;
             self.g *= rescale;
+            self.pruned *= rescale;
             self.m = d;
         }
         let e = (-self.alpha * (d - self.m)).exp();
@@ -79,6 +84,7 @@ impl Accumulator {
         if d < self.m {
             let rescale = (-self.alpha * (self.m - d)).exp();
             self.s *= rescale;
+            self.pruned *= rescale;
             self.m = d;
         }
         let e = w * (-self.alpha * (d - self.m)).exp();
@@ -136,7 +142,8 @@ impl Accumulator {
                 (f64::INFINITY, DVec3::ZERO, true)
             }
         } else if self.s > 0.0 {
-            (self.m - self.s.ln() / self.alpha, self.g / self.s, false)
+            let total = self.s + self.pruned;
+            (self.m - total.ln() / self.alpha, self.g / total, false)
         } else {
             (f64::INFINITY, DVec3::ZERO, false)
         }

@@ -5,6 +5,7 @@
 //! above by the caller), far field (one term `n w exp(-alpha r)`), exact (a leaf's
 //! primitives) or opened.
 
+use super::accumulate::Accumulation;
 use super::smooth::{EvalParams, EvalStats, Sink};
 use crate::bvh::moments::{MIDDLE, lin_bound, quadratic_form};
 use crate::bvh::wide::{EMPTY, Root};
@@ -108,6 +109,29 @@ pub(super) struct Walk<'w, 'a, P, const GRAD: bool, const SLOPE: bool> {
     w_ff: f64,
     /// Second moments per wide node, when far fields use them (points).
     moments: &'w [Moments4],
+    /// Share of the sum that subtrees pruned against the budget may hold together (0 =
+    /// off; `eval::smooth` module docs).
+    budget: f64,
+    ln2_over_alpha: f64,
+    alpha_log2e: f64,
+    /// `floor(log2 w_ff) + 1`: `2^e_w` bounds the weight of one primitive.
+    e_w: i64,
+}
+
+/// `floor(log2 v)` for a positive normal `v`.
+#[inline(always)]
+fn exponent(v: f64) -> i64 {
+    ((v.to_bits() >> 52) & 0x7ff) as i64 - 1023
+}
+
+/// `2^e` for `e <= 1023` (0 below the normal range, where the charge is negligible).
+#[inline(always)]
+fn pow2(e: i64) -> f64 {
+    if e < -1022 {
+        0.0
+    } else {
+        f64::from_bits(((e + 1023).min(2046) as u64) << 52)
+    }
 }
 
 impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, GRAD, SLOPE> {
@@ -134,6 +158,14 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             beta2: if p.beta > 0.0 { p.beta * p.beta } else { -1.0 },
             w_ff: scale.max_weight(),
             moments: if p.moments { &set.bvh.moments } else { &[] },
+            budget: if p.budget && p.prune && p.accumulation == Accumulation::Stable {
+                p.prune_tolerance
+            } else {
+                0.0
+            },
+            ln2_over_alpha: std::f64::consts::LN_2 / p.alpha,
+            alpha_log2e: p.alpha * std::f64::consts::LOG2_E,
+            e_w: exponent(scale.max_weight()) + 1,
         }
     }
 
@@ -144,6 +176,47 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         let acc = &self.sink.acc;
         let reach = acc.m + (self.prune_margin - acc.ln_sum_lower_bound() * self.inv_alpha);
         reach * reach
+    }
+
+    /// Below this squared distance no subtree fits in what is left of the budget, not
+    /// even a single primitive (`+inf` when off or spent): one comparison spares the
+    /// others the test.
+    #[inline(always)]
+    fn budget2(&self) -> f64 {
+        let acc = &self.sink.acc;
+        let left = self.budget * acc.shifted_sum() - acc.pruned;
+        if self.budget > 0.0 && left > 0.0 {
+            let k = (self.e_w - exponent(left)).max(0);
+            let need = acc.m + k as f64 * self.ln2_over_alpha;
+            need * need
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Prunes a subtree of `n` primitives at squared distance `r2` if its bound
+    /// `n w exp(-alpha (r - m))` fits in what is left of the budget `tol S - P`: with
+    /// `2^e_nw >= n w` and `2^e_left <= tol S - P`, it fits once `alpha (r - m) >= k ln 2`
+    /// for `k = e_nw - e_left`, and `P` grows by `2^(e_nw - j)`, `j = floor(alpha (r - m)
+    /// log2 e) >= k`, an upper bound of the subtree's mass that stays within the budget.
+    #[inline(always)]
+    fn budget_prune(&mut self, r2: f64, n: u32) -> bool {
+        let acc = &mut *self.sink.acc;
+        let left = self.budget * acc.shifted_sum() - acc.pruned;
+        if !(left > 0.0) {
+            return false;
+        }
+        let e_left = exponent(left);
+        let e_nw = exponent(n as f64 * self.w_ff) + 1;
+        let k = (e_nw - e_left).max(0);
+        let need = acc.m + k as f64 * self.ln2_over_alpha;
+        if r2 < need * need {
+            return false;
+        }
+        let j = ((r2.sqrt() - acc.m) * self.alpha_log2e) as i64;
+        acc.pruned += pow2(e_nw - j.max(k));
+        self.stats.pruned += 1;
+        true
     }
 
     #[inline(always)]
@@ -187,6 +260,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         while let Some(e) = self.stack.pop() {
             self.stats.nodes += 1;
             let reach2 = self.reach2();
+            let budget2 = self.budget2();
             if e.r2 > reach2 {
                 self.stats.pruned += 1;
                 continue;
@@ -203,7 +277,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             let d2 = child_distances2(node, self.x);
             let mut open = Open::new();
             for j in 0..2 {
-                self.middle(node, e.i, j, &d2, reach2, &mut open);
+                self.middle(node, e.i, j, &d2, (reach2, budget2), &mut open);
             }
             self.push(node, &open);
         }
@@ -230,7 +304,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         i: u32,
         j: usize,
         d2: &[f64; 4],
-        reach2: f64,
+        (reach2, budget2): (f64, f64),
         open: &mut Open,
     ) {
         let near = if d2[2 * j] <= d2[2 * j + 1] {
@@ -248,8 +322,11 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             self.far_middle(node, i, j, (near, r2m));
             return;
         }
+        if r2m >= budget2 && self.budget_prune(r2m, node.mid_size[j]) {
+            return;
+        }
         for k in [2 * j, 2 * j + 1] {
-            self.slot(node, i, k, d2[k], reach2, open);
+            self.slot(node, i, k, d2[k], (reach2, budget2), open);
         }
     }
 
@@ -315,7 +392,15 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
     /// Decides slot `k` of wide node `i` at squared distance `d2k`: pruned, far field,
     /// or to be opened (leaves too: they are summed when popped).
     #[inline(always)]
-    fn slot(&mut self, node: &Node4, i: u32, k: usize, d2k: f64, reach2: f64, open: &mut Open) {
+    fn slot(
+        &mut self,
+        node: &Node4,
+        i: u32,
+        k: usize,
+        d2k: f64,
+        (reach2, budget2): (f64, f64),
+        open: &mut Open,
+    ) {
         let c = node.count[k];
         if c == EMPTY {
             return;
@@ -326,6 +411,9 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         }
         if c == 0 && self.far_ok(node.diam2[k], d2k) {
             self.far_slot(node, i, k, d2k);
+            return;
+        }
+        if d2k >= budget2 && self.budget_prune(d2k, node.size[k]) {
             return;
         }
         open.insert(d2k, k);
