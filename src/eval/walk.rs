@@ -203,7 +203,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
     fn budget_prune(&mut self, r2: f64, n: u32) -> bool {
         let acc = &mut *self.sink.acc;
         let left = self.budget * acc.shifted_sum() - acc.pruned;
-        if !(left > 0.0) {
+        if left.is_nan() || left <= 0.0 {
             return false;
         }
         let e_left = exponent(left);
