@@ -204,6 +204,16 @@ fn render_writes_png_stats_and_depth() {
         serde_json::from_str(&std::fs::read_to_string(d.path().join("st.json")).unwrap()).unwrap();
     assert_eq!(json["image"]["rays"], 48 * 32);
     assert!(json["image"]["hits"].as_u64().unwrap() > 0);
+    // A point cloud: full evaluations that only take a step run at the coarser step
+    // beta, and are counted apart as well as among the full ones.
+    let (evals, steps) = (
+        json["evals_per_hit_ray"].as_f64().unwrap(),
+        json["step_evals_per_hit_ray"].as_f64().unwrap(),
+    );
+    assert!(
+        steps > 0.0 && steps < evals,
+        "{steps} step of {evals} evaluations"
+    );
     let depth = image::open(d.path().join("depth.exr")).unwrap().to_rgb32f();
     let centre = depth.get_pixel(24, 16)[0];
     assert!(centre > 2.0 && centre < 4.0, "depth at the centre {centre}");

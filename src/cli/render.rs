@@ -554,6 +554,7 @@ fn image_json(st: &ImageStats, built: &BuiltScene) -> serde_json::Value {
         "image": st,
         "evals_per_ray": st.evals_per_ray(),
         "evals_per_hit_ray": st.evals_per_hit(),
+        "step_evals_per_hit_ray": st.step_evals_per_hit(),
         "bound_evals_per_ray": st.bound_evals_per_ray(),
         "bound_evals_per_hit_ray": st.bound_evals_per_hit(),
         "tile_evals_per_ray": st.tile_evals_per_ray(),

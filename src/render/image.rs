@@ -63,6 +63,11 @@ pub struct ImageStats {
     pub coarse_evals: u64,
     /// Field evaluations over the rays that hit.
     pub hit_evals: u64,
+    /// Full evaluations that only took a step, at the coarser step beta of point clouds
+    /// (included in `evals`; `render::tracer` item 10).
+    pub step_evals: u64,
+    /// The same over the rays that hit (included in `hit_evals`).
+    pub hit_step_evals: u64,
     pub max_evals_per_ray: u32,
     /// Exact plus far-field terms over all evaluations.
     pub leaves: u64,
@@ -101,6 +106,7 @@ impl ImageStats {
         self.rays += 1;
         self.evals += st.evals as u64;
         self.coarse_evals += st.coarse_evals as u64;
+        self.step_evals += st.step_evals as u64;
         self.max_evals_per_ray = self.max_evals_per_ray.max(st.evals + st.coarse_evals);
         self.leaves += st.eval.leaves() as u64;
         self.coarse_leaves += st.coarse_leaves as u64;
@@ -113,6 +119,7 @@ impl ImageStats {
         if r.hit.is_some() {
             self.hits += 1;
             self.hit_evals += st.evals as u64;
+            self.hit_step_evals += st.step_evals as u64;
             self.hit_coarse_evals += st.coarse_evals as u64;
             self.hit_leaves += st.eval.leaves() as u64;
         } else {
@@ -129,6 +136,8 @@ impl ImageStats {
         self.evals += o.evals;
         self.coarse_evals += o.coarse_evals;
         self.hit_evals += o.hit_evals;
+        self.step_evals += o.step_evals;
+        self.hit_step_evals += o.hit_step_evals;
         self.max_evals_per_ray = self.max_evals_per_ray.max(o.max_evals_per_ray);
         self.leaves += o.leaves;
         self.coarse_leaves += o.coarse_leaves;
@@ -158,6 +167,11 @@ impl ImageStats {
     /// Full-accuracy evaluations per ray that hit.
     pub fn evals_per_hit(&self) -> f64 {
         self.hit_evals as f64 / self.hits.max(1) as f64
+    }
+    /// Full evaluations per ray that hit that only took a step at the coarser step beta
+    /// (part of [`ImageStats::evals_per_hit`]).
+    pub fn step_evals_per_hit(&self) -> f64 {
+        self.hit_step_evals as f64 / self.hits.max(1) as f64
     }
     /// Bound steps (coarse evaluations) per ray that hit, its own only: the tile
     /// marches it shared are counted in [`ImageStats::tile_evals_per_ray`].

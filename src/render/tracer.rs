@@ -156,6 +156,9 @@ pub struct RayStats {
     pub eval: EvalStats,
     /// Leaves visited by the coarse evaluations alone (included in `eval`).
     pub coarse_leaves: u32,
+    /// Full evaluations that only took a step, made at the coarser step beta (point
+    /// clouds, module docs item 10; counted in `evals` too).
+    pub step_evals: u32,
     /// Retries with a smaller alpha after an infinite (underflowed) naive evaluation.
     pub falloffs: u32,
     /// Evaluations spent locating a crossing after overshooting into the negative band.
@@ -376,6 +379,7 @@ impl<'a> Tracer<'a> {
                     stats.coarse_leaves += sample.stats.leaves();
                 } else {
                     stats.evals += 1;
+                    stats.step_evals += u32::from(!accurate && beta > obj.params.beta);
                 }
                 stats.eval.add(&sample.stats);
                 sample
