@@ -2,6 +2,7 @@
 
 pub mod cone;
 pub mod object;
+mod stepper;
 pub mod tracer;
 
 pub use object::TraceObject;
