@@ -16,14 +16,21 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 /// The moments of the four slots of one wide node and of its two middles (pairs of
-/// slots 0-1 and 2-3), at indices 0..4 and 4, 5 (structure of arrays, like `Node4`).
-/// A middle's box is the union of its slots' boxes.
+/// slots 0-1 and 2-3), at indices 0..4 and 4, 5. A middle's box is the union of its
+/// slots' boxes. Entry by entry (36 bytes each): a far-field term reads one entry, mostly
+/// within one cache line.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Moments4 {
-    /// The reference point `c` minus the box's min corner, per axis and entry.
-    pub c: [[f32; 6]; 3],
-    /// The second moment about `c`, padded: xx, yy, zz, xy, xz, yz, per entry.
-    pub m: [[f32; 6]; 6],
+    pub e: [MomentEntry; 6],
+}
+
+/// The moments of one slot or middle.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MomentEntry {
+    /// The reference point `c` minus the box's min corner.
+    pub c: [f32; 3],
+    /// The second moment about `c`, padded: xx, yy, zz, xy, xz, yz.
+    pub m: [f32; 6],
 }
 
 /// Index of middle `j`'s entry in a [`Moments4`].
@@ -200,12 +207,13 @@ fn store(m: &mut Moments4, k: usize, min: DVec3, s: &Stats) {
     let mut second = s.scatter.map(|v| v * inv_n);
     add_outer(&mut second, s.mean - c, 1.0);
     let pad = 4e-7 * (second[0] + second[1] + second[2]);
+    let entry = &mut m.e[k];
     for a in 0..3 {
-        m.c[a][k] = crel[a];
-        m.m[a][k] = f32_up(second[a].max(0.0) + pad);
+        entry.c[a] = crel[a];
+        entry.m[a] = f32_up(second[a].max(0.0) + pad);
     }
     for (a, v) in second.iter().enumerate().skip(3) {
-        m.m[a][k] = *v as f32;
+        entry.m[a] = *v as f32;
     }
 }
 
@@ -256,7 +264,7 @@ mod tests {
                         .map(|&k| slot_min(w, k))
                         .fold(DVec3::INFINITY, DVec3::min);
                     let m = &moments[i];
-                    let crel = [m.c[0][e], m.c[1][e], m.c[2][e]];
+                    let crel = m.e[e].c;
                     let c = min + DVec3::from(crel.map(f64::from));
                     let mean =
                         below.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / below.len() as f64;
@@ -273,7 +281,7 @@ mod tests {
                             .map(|p| (u.dot(p.as_dvec3() - c)).powi(2))
                             .sum::<f64>()
                             / below.len() as f64;
-                        let mm = m.m.map(|r| r[e] as f64);
+                        let mm = m.e[e].m.map(f64::from);
                         let stored = quadratic_form(&mm, u);
                         assert!(
                             stored >= exact,

@@ -371,16 +371,10 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             .filter(|_| near.0 < reach * reach)
         {
             Some(m) => {
-                let crel = [m.c[0][e], m.c[1][e], m.c[2][e]];
+                let entry = &m.e[e];
+                let crel = entry.c;
                 let c = bx.0 + DVec3::new(crel[0] as f64, crel[1] as f64, crel[2] as f64);
-                let mm = [
-                    m.m[0][e] as f64,
-                    m.m[1][e] as f64,
-                    m.m[2][e] as f64,
-                    m.m[3][e] as f64,
-                    m.m[4][e] as f64,
-                    m.m[5][e] as f64,
-                ];
+                let mm = entry.m.map(f64::from);
                 let sigma2 = |u: DVec3| quadratic_form(&mm, u);
                 let lin = lin_bound(crel, c);
                 self.sink.far_moments(self.x, w, bx, c, sigma2, lin, near);
