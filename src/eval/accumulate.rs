@@ -51,20 +51,27 @@ impl Accumulator {
         }
     }
 
-    /// Adds the term `w exp(-alpha d)` with unit direction `dir` (gradient of `d`) and
-    /// weight gradient `grad_w`.
-    /// Returns the term as added to the shifted sum, `w exp(-alpha (d - m))`.
+    /// Moves the reference down to `d` if it is below it, rescaling the shifted sums
+    /// (the naive ones are not shifted).
     #[inline]
-    pub fn add(&mut self, d: f64, w: f64, dir: DVec3, grad_w: DVec3) -> f64 {
-        let inv_alpha = 1.0 / self.alpha;
+    fn shift(&mut self, d: f64) {
         if d < self.m {
-            // exp(-inf) = 0 on the first term, when s and g are still zero.
+            // exp(-inf) = 0 on the first term, when the sums are still zero.
             let rescale = (-self.alpha * (self.m - d)).exp();
             self.s *= rescale;
             self.g *= rescale;
             self.pruned *= rescale;
             self.m = d;
         }
+    }
+
+    /// Adds the term `w exp(-alpha d)` with unit direction `dir` (gradient of `d`) and
+    /// weight gradient `grad_w`.
+    /// Returns the term as added to the shifted sum, `w exp(-alpha (d - m))`.
+    #[inline]
+    pub fn add(&mut self, d: f64, w: f64, dir: DVec3, grad_w: DVec3) -> f64 {
+        let inv_alpha = 1.0 / self.alpha;
+        self.shift(d);
         let e = (-self.alpha * (d - self.m)).exp();
         let gterm = w * dir - grad_w * inv_alpha;
         self.s += w * e;
@@ -81,12 +88,7 @@ impl Accumulator {
     /// term as added to the shifted sum, `w exp(-alpha (d - m))`.
     #[inline]
     pub fn add_value(&mut self, d: f64, w: f64) -> f64 {
-        if d < self.m {
-            let rescale = (-self.alpha * (self.m - d)).exp();
-            self.s *= rescale;
-            self.pruned *= rescale;
-            self.m = d;
-        }
+        self.shift(d);
         let e = w * (-self.alpha * (d - self.m)).exp();
         self.s += e;
         if self.naive {

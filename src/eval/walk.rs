@@ -178,16 +178,21 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         reach * reach
     }
 
+    /// What is left of the budget, `tol S - P` (at most 0 when off or spent).
+    #[inline(always)]
+    fn budget_left(&self) -> f64 {
+        self.budget * self.sink.acc.shifted_sum() - self.sink.acc.pruned
+    }
+
     /// Below this squared distance no subtree fits in what is left of the budget, not
     /// even a single primitive (`+inf` when off or spent): one comparison spares the
     /// others the test.
     #[inline(always)]
     fn budget2(&self) -> f64 {
-        let acc = &self.sink.acc;
-        let left = self.budget * acc.shifted_sum() - acc.pruned;
-        if self.budget > 0.0 && left > 0.0 {
+        let left = self.budget_left();
+        if left > 0.0 {
             let k = (self.e_w - exponent(left)).max(0);
-            let need = acc.m + k as f64 * self.ln2_over_alpha;
+            let need = self.sink.acc.m + k as f64 * self.ln2_over_alpha;
             need * need
         } else {
             f64::INFINITY
@@ -201,11 +206,11 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
     /// log2 e) >= k`, an upper bound of the subtree's mass that stays within the budget.
     #[inline(always)]
     fn budget_prune(&mut self, r2: f64, n: u32) -> bool {
-        let acc = &mut *self.sink.acc;
-        let left = self.budget * acc.shifted_sum() - acc.pruned;
-        if left.is_nan() || left <= 0.0 {
+        let left = self.budget_left();
+        if left <= 0.0 {
             return false;
         }
+        let acc = &mut *self.sink.acc;
         let e_left = exponent(left);
         let e_nw = exponent(n as f64 * self.w_ff) + 1;
         let k = (e_nw - e_left).max(0);
