@@ -180,6 +180,35 @@ pub(crate) fn bennett_g(z: f64) -> f64 {
     }
 }
 
+/// Grid step of [`bennett_g_chord`]'s table, and the grid's end.
+const G_STEP: f64 = 0.25;
+const G_END: f64 = 32.0;
+const G_POINTS: usize = (G_END / G_STEP) as usize + 1;
+
+/// `bennett_g` at the grid points `k G_STEP`, rounded up.
+static G_TABLE: std::sync::LazyLock<[f64; G_POINTS]> = std::sync::LazyLock::new(|| {
+    std::array::from_fn(|k| bennett_g(k as f64 * G_STEP) * (1.0 + 1e-12))
+});
+
+/// An upper bound of `g(z)` for `z >= 0` that costs no exponential: `g` is convex (its
+/// Taylor coefficients are positive), so on each grid interval the chord through its
+/// ends lies above it (by at most 0.7%: `e^z` over a quarter bends that much); past the
+/// grid, `bennett_g` itself (both rounded up by a relative 1e-12, above the rounding of
+/// `exp`). Saves the far-field terms of point clouds one exponential each (deer alpha 1
+/// trace 3-5% faster).
+#[inline]
+pub(crate) fn bennett_g_chord(z: f64) -> f64 {
+    if z < G_END {
+        let table = &*G_TABLE;
+        let u = z.max(0.0) * (1.0 / G_STEP);
+        let k = (u as usize).min(G_POINTS - 2);
+        let (lo, hi) = (table[k], table[k + 1]);
+        lo + (hi - lo) * (u - k as f64)
+    } else {
+        bennett_g(z) * (1.0 + 1e-12)
+    }
+}
+
 /// Evaluates the smooth distance of the union of `sets` at `x`, with its gradient.
 pub fn evaluate(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
     evaluate_impl::<true, false>(sets, x, DVec3::ZERO, p, 0.0)
@@ -378,7 +407,7 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
             // The largest u . (q - c) over the box bounds every point's.
             let far_corner = DVec3::select(u.cmpge(DVec3::ZERO), bx.1, bx.0);
             let z = alpha * u.dot(far_corner - c).max(0.0);
-            let f = (1.0 + alpha * lin + alpha * alpha * sigma2(u).max(0.0) * bennett_g(z))
+            let f = (1.0 + alpha * lin + alpha * alpha * sigma2(u).max(0.0) * bennett_g_chord(z))
                 * (1.0 + 1e-9);
             // ln f <= f - 1: where `f - 1 <= alpha (l - r)` the moment term is the smaller.
             let reach = l - (f - 1.0) / alpha;
@@ -426,5 +455,40 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
             let (d, w) = prim.value(x, scale);
             self.acc.add_value(d, w);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `g(z)` in long arithmetic: its series to convergence (all terms positive).
+    fn g_series(z: f64) -> f64 {
+        let (mut term, mut sum, mut k) = (0.5f64, 0.0f64, 0.0f64);
+        while term > 1e-18 * sum.max(1e-300) || k < 3.0 {
+            sum += term;
+            k += 1.0;
+            term *= z / (k + 2.0);
+        }
+        sum
+    }
+
+    #[test]
+    fn bennett_g_chord_bounds_g_from_above_and_stays_close() {
+        let mut worst: f64 = 0.0;
+        for i in 0..=40_000 {
+            let z = i as f64 * 1e-3;
+            let g = g_series(z);
+            let chord = bennett_g_chord(z);
+            assert!(chord >= g, "z {z}: chord {chord} below g {g}");
+            assert!(
+                bennett_g(z) >= g * (1.0 - 1e-14),
+                "z {z}: bennett_g below g"
+            );
+            worst = worst.max(chord / g - 1.0);
+        }
+        // Chords of a convex function on steps of 1/4 (g bends like e^z for large z).
+        assert!(worst < 7e-3, "chord up to {worst} above g");
+        assert!(bennett_g_chord(1e3).is_infinite() && bennett_g_chord(0.0) >= 0.5);
     }
 }
