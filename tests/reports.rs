@@ -92,6 +92,8 @@ fn bench_quick_on_procedural_rows_with_paper_mode() {
             "--rows",
             "net,torus",
             "--paper-mode",
+            "--repeat",
+            "3",
             "--scenes-dir",
             scenes.to_str().unwrap(),
             "--csv",
@@ -130,6 +132,9 @@ fn bench_quick_on_procedural_rows_with_paper_mode() {
     assert_eq!(rows[1][col(&h, "width")], "64");
     for r in &rows {
         assert!(num(&r[col(&h, "seconds")]) > 0.0);
+        // The fastest of three renders, and their median.
+        assert_eq!(r[col(&h, "runs")], "3");
+        assert!(num(&r[col(&h, "seconds_median")]) >= num(&r[col(&h, "seconds")]));
         assert!(num(&r[col(&h, "speedup")]) > 0.0);
         assert!(num(&r[col(&h, "leaves_per_eval")]) >= 1.0);
         assert_eq!(r[col(&h, "skipped")], "");
@@ -172,6 +177,12 @@ fn bench_rejects_an_unknown_row() {
         err.contains("unknown Table 1 row 'teapot'") && err.contains("hex_torus"),
         "{err}"
     );
+    for bad in ["0", "21"] {
+        let out = run(dir.path(), &["bench", "--quick", "--repeat", bad]);
+        assert_eq!(out.status.code(), Some(2), "--repeat {bad}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("--repeat must be in 1..=20"), "{err}");
+    }
 }
 
 #[test]

@@ -38,6 +38,10 @@ pub struct BenchArgs {
     /// smaller one is faster, and the speedup is then per ray).
     #[arg(long, value_name = "WxH", requires = "paper_mode")]
     paper_size: Option<String>,
+    /// Render each row this many times and report the fastest, with the median beside it
+    /// (1..=20; a busy or virtual machine's noise then shows and mostly drops out).
+    #[arg(long, default_value_t = 1)]
+    repeat: i64,
     /// Write the table as CSV.
     #[arg(long)]
     csv: Option<PathBuf>,
@@ -77,6 +81,9 @@ pub fn run(a: BenchArgs) -> Result<()> {
     if !(0..=1024).contains(&a.threads) {
         bail!("--threads must be in 0..=1024 (got {})", a.threads);
     }
+    if !(1..=20).contains(&a.repeat) {
+        bail!("--repeat must be in 1..=20 (got {})", a.repeat);
+    }
     let paper_mode = match (&a.paper_size, a.paper_mode) {
         (Some(s), _) => Some(parse_size(s)?),
         (None, true) => Some((width, height)),
@@ -89,6 +96,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
         height,
         threads: a.threads as usize,
         paper_mode,
+        repeat: a.repeat as usize,
     };
     bench::select_rows(&opts.rows)?;
     super::outputs::check_report_outputs(&a.csv, &a.json, None)?;
