@@ -38,7 +38,8 @@
 //! point `c` and any unit `u`, `|x - p_i| >= u . (x - p_i)`, so with `Y_i = u . (p_i - c)`
 //! the subtree sums to at most `w exp(-alpha u . (x - c)) sum exp(alpha Y_i)`. Bennett's
 //! bound `e^(a y) <= 1 + a y + a^2 y^2 g(a b)` for `y <= b`, `g(z) = (e^z - 1 - z) / z^2`
-//! (increasing), with `b` the largest `u . (q - c)` over the box, the second moment
+//! (increasing and convex: taken from above by the chords of a table, `bennett_g_chord`),
+//! with `b` the largest `u . (q - c)` over the box, the second moment
 //! `sigma^2 = u^T M u` about `c` (`bvh::moments`, rounded up) and `|mean - c| <= lin`,
 //! gives, for `u = (x - c) / |x - c|`,
 //! `n w F exp(-alpha |x - c|)`, `F = 1 + alpha lin + alpha^2 sigma^2 g(alpha b)`.
