@@ -17,7 +17,7 @@ use super::{Progress, peak_rss_mib, render_objects, reset_peak_rss, rss_mib};
 use crate::eval::Accumulation;
 use crate::primitives::PrimitiveKind;
 use crate::render::build::build_scene;
-use crate::render::image::{ImageStats, Rendered};
+use crate::render::image::ImageStats;
 use crate::render::{TraceObject, TracerOptions};
 use crate::scene::{Scene, SceneError};
 use std::path::PathBuf;
@@ -279,10 +279,8 @@ fn run_row(
     let first = &built.objects[0];
     let alpha = first.params.alpha;
     let alpha_diag = alpha * first.bounds.diagonal();
-    let mut runs = Vec::new();
-    let mut rendered = None;
-    for _ in 0..opts.repeat.max(1) {
-        let r = render_objects(
+    let render = || {
+        render_objects(
             &built.objects,
             TracerOptions::new(built.epsilon, scene.render.max_steps),
             &built.camera,
@@ -290,17 +288,18 @@ fn run_row(
             scene.image.background,
             paper.name,
             progress,
-        );
-        runs.push(r.stats.seconds);
+        )
+    };
+    let mut rendered = render();
+    let mut runs = vec![rendered.stats.seconds];
+    for _ in 1..opts.repeat {
         // The same image and counts every time: only the time differs.
-        if rendered
-            .as_ref()
-            .is_none_or(|best: &Rendered| r.stats.seconds < best.stats.seconds)
-        {
-            rendered = Some(r);
+        let r = render();
+        runs.push(r.stats.seconds);
+        if r.stats.seconds < rendered.stats.seconds {
+            rendered = r;
         }
     }
-    let rendered = rendered.expect("at least one render");
     let peak = peak_rss_mib();
     let paper_mode = match opts.paper_mode {
         None => None,
