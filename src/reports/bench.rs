@@ -13,7 +13,7 @@
 
 use super::compare::{DepthDiff, compare_depths};
 use super::table::{Cell, Table};
-use super::{Progress, peak_rss_mib, render_objects, reset_peak_rss, rss_mib};
+use super::{Progress, peak_rss_mib, quantile, render_objects, reset_peak_rss, rss_mib};
 use crate::eval::Accumulation;
 use crate::primitives::PrimitiveKind;
 use crate::render::build::build_scene;
@@ -428,17 +428,6 @@ pub fn text(table: &Table) -> String {
     out
 }
 
-/// The median of `v` (the mean of the middle two for an even count; 0 when empty).
-fn median(v: &[f64]) -> f64 {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => 0.0,
-        n if n % 2 == 1 => v[n / 2],
-        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
-}
-
 /// The report as a table (columns documented in `doc/reports.md`).
 pub fn table(rows: &[BenchRow]) -> Table {
     let mut t = Table::new(&[
@@ -506,7 +495,7 @@ pub fn table(rows: &[BenchRow]) -> Table {
                     Cell::num(m.alpha_diag, 1),
                     Cell::num(p.seconds, 3),
                     Cell::num(st.seconds, 3),
-                    Cell::num(median(&m.runs), 3),
+                    Cell::num(quantile(&mut m.runs.clone(), 0.5), 3),
                     Cell::int(m.runs.len() as i64),
                     Cell::int(st.threads as i64),
                     Cell::int(st.width as i64),
