@@ -27,6 +27,8 @@ pub(super) struct Stepper {
     /// Slope of the field along the ray (decrease per unit of `t`) from the last two
     /// samples of the same kind, in `[0, 1]`; 1 (no relaxation) until known.
     pub(super) slope: f64,
+    /// `slope` was measured (the last two samples were of the same kind), not assumed.
+    pub(super) slope_known: bool,
     last: Option<(f64, f64, Kind)>,
     /// The last step was longer than its sample's value.
     relaxed: bool,
@@ -40,6 +42,7 @@ impl Stepper {
         Stepper {
             on,
             slope: 1.0,
+            slope_known: false,
             last: None,
             relaxed: false,
         }
@@ -59,6 +62,7 @@ impl Stepper {
         }
         self.relaxed = false;
         self.slope = 1.0;
+        self.slope_known = false;
         self.last = None;
         Some(tp + sp)
     }
@@ -78,8 +82,10 @@ impl Stepper {
             && t > tl
         {
             self.slope = ((sl - s) / (t - tl)).clamp(0.0, 1.0);
+            self.slope_known = true;
         } else {
             self.slope = 1.0;
+            self.slope_known = false;
         }
         self.last = Some((t, s, kind));
         let factor = if self.on {

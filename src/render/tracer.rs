@@ -449,6 +449,11 @@ impl<'a> Tracer<'a> {
         let coarse = (self.options.coarse_beta > 0.0).then_some(self.options.coarse_beta);
         let tau = self.options.coarse_threshold * eps;
         let mut near = false;
+        // How far the bound step's value fell below the full value where both were last
+        // taken (module docs, item 5): a bound step is only worth taking where the full
+        // value minus this gap stays above the threshold.
+        let mut coarse_at: Option<f64> = None;
+        let mut gap = 0.0f64;
         // Full-accuracy evaluations carry the gradient when they are predicted to hit,
         // so the hit needs no second traversal to be shaded: the next value is guessed
         // from the slope of the last two values (sphere tracing converges about
@@ -481,12 +486,16 @@ impl<'a> Tracer<'a> {
                 if c.s.abs() <= eps {
                     want = Want::Gradient;
                 }
+                coarse_at = Some(c.s);
             }
             // An evaluation predicted to hit is made at the hit beta.
             let fine = accurate || (refine && want == Want::Gradient);
             accurate |= fine && self.sticky;
             let along = self.options.reach_steps.then_some((d, t_max - t));
             let mut f = self.sample(x, &mut stats, want, fine, along);
+            if let Some(c) = coarse_at.take() {
+                gap = (f.s - c).max(0.0);
+            }
             if let Some(back) = stepper.uncovered(prev, t, f.s) {
                 // An over-relaxed step left a gap: go back to the plain step's end.
                 stats.rejected_steps += 1;
@@ -501,7 +510,7 @@ impl<'a> Tracer<'a> {
                 stats.refinements += 1;
                 f = self.sample(x, &mut stats, Want::Gradient, true, along);
             }
-            near = f.s < 2.0 * tau;
+            near = f.s - gap < 2.0 * tau;
             if f.s.abs() <= eps {
                 let hit = self.hit(o, d, t, &f, &mut stats);
                 return RayResult {
@@ -522,7 +531,16 @@ impl<'a> Tracer<'a> {
             }
             let step = stepper.step(prev, t, f.s, f.reach, Kind::Full);
             // The value at the next sample, if the field keeps its slope along the ray.
-            let predicted = f.s - stepper.slope * step;
+            // Before the slope is known (the first full value after bound steps), a step
+            // by the free distance is taken to about halve the value (point clouds); the
+            // plain guess (slope 1) would predict a hit after every such step. Objects
+            // whose hits take a finer beta (`sticky`) keep the plain guess: their first
+            // fine evaluation is better early than late.
+            let predicted = if stepper.slope_known || self.sticky {
+                f.s - stepper.slope * step
+            } else {
+                0.5 * f.s
+            };
             want = if predicted <= 2.0 * eps || f.s <= 2.0 * eps {
                 Want::Gradient
             } else {
