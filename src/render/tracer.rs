@@ -16,12 +16,15 @@
 //! 5. Far from the surface, steps are bound steps: a coarser Barnes-Hut sum
 //!    (`coarse_beta`, cheaper, and a lower bound of the scene's sum, so the steps stay
 //!    safe) until it falls below `coarse_threshold * epsilon`; from there on the scene's
-//!    own beta decides the hit. Where a bound value fell through, the gap to the full
-//!    value at the same point is kept: a later bound step is taken only where the full
-//!    value minus that gap clears twice the threshold (near a soft point cloud the
-//!    coarse sum is several epsilons low, and a bound step there would only fall through
-//!    again). Primary rays reach this loop after their tile's cone march
-//!    (`render::cone`), which takes the far steps once for a whole tile.
+//!    own beta decides the hit. The bound value that falls through is still a safe step
+//!    when it is above epsilon (no full value there could hit), and it is taken: on
+//!    edges and triangles the coarse sum is nearly exact, and a full evaluation at the
+//!    same point would only repeat it. The gap between that bound value and the full
+//!    value that follows is kept: a later bound step is taken only where the full value
+//!    minus the gap clears twice the threshold (near a soft point cloud the coarse sum
+//!    is several epsilons low, and a bound step there would only fall through again).
+//!    Primary rays reach this loop after their tile's cone march (`render::cone`), which
+//!    takes the far steps once for a whole tile.
 //! 6. Full-accuracy evaluations prune with a tolerance tied to epsilon: subtrees whose
 //!    terms hold together less than `tol = min(0.005 alpha epsilon, 1e-3)` of the sum are
 //!    skipped and covered from above, which lowers `s` by at most `2 tol / alpha`, 1% of
@@ -456,9 +459,10 @@ impl<'a> Tracer<'a> {
         let coarse = (self.options.coarse_beta > 0.0).then_some(self.options.coarse_beta);
         let tau = self.options.coarse_threshold * eps;
         let mut near = false;
-        // How far the bound step's value fell below the full value where both were last
-        // taken (module docs, item 5): a bound step is only worth taking where the full
-        // value minus this gap stays above the threshold.
+        // How far the bound step's value fell below the full value that followed it
+        // (module docs, item 5; at the next point, so about the gap there): a bound step
+        // is only worth taking where the full value minus this gap stays above the
+        // threshold.
         let mut coarse_at: Option<f64> = None;
         let mut gap = 0.0f64;
         // Full-accuracy evaluations carry the gradient when they are predicted to hit,
@@ -477,7 +481,11 @@ impl<'a> Tracer<'a> {
             let x = o + t * d;
             if let (Some(beta), false) = (coarse, near) {
                 let c = self.sample(x, &mut stats, Want::Bound(beta), false, None);
-                if c.s > tau {
+                if c.s > eps {
+                    // Outside the hit band the bound's own step is safe: taken here even
+                    // when the value fell below the threshold (a full value at this
+                    // point could not hit either, and where the bound is tight it would
+                    // only repeat it). The next sample is then a full one.
                     if let Some(back) = stepper.uncovered(prev, t, c.s) {
                         stats.rejected_steps += 1;
                         t = back;
@@ -486,6 +494,17 @@ impl<'a> Tracer<'a> {
                     let step = stepper.step(prev, t, c.s, c.s, Kind::Bound);
                     prev = Some((t, c.s, c.s));
                     t += step;
+                    if c.s <= tau {
+                        near = true;
+                        coarse_at = Some(c.s);
+                        // Edges and triangles: a full value after a bound step that fell
+                        // through is usually in the band (their bound is nearly exact).
+                        want = if self.sticky {
+                            Want::Gradient
+                        } else {
+                            Want::Value
+                        };
+                    }
                     continue;
                 }
                 // A coarse value already within the hit band is usually a hit (where
