@@ -7,8 +7,10 @@
 //!   rays hitting in both within 4 epsilon). Thin features (the net's and hex torus'
 //!   tubes, the bucky ball's struts, the spiky sphere's spikes) are where a skipped
 //!   surface would show. Over-relaxed steps (`TracerOptions::relax`) likewise against
-//!   plain sphere-tracing steps, and steps by the free distance from the terms' slopes
-//!   (`TracerOptions::reach_steps`, point clouds) against plain steps.
+//!   plain sphere-tracing steps, steps by the free distance from the terms' slopes
+//!   (`TracerOptions::reach_steps`, point clouds) against plain steps, and rays started
+//!   past their neighbours' empty balls (`TracerOptions::neighbours`) against rays that
+//!   only use their own.
 //! - At beta 0.5 the rendered surface stays close to the exact (beta 0) one: median depth
 //!   error at most 0.1% of the scene's diagonal on the procedural scenes and the bunny,
 //!   and on the full bunny's edges at its native size, where that needs hits decided at
@@ -95,6 +97,24 @@ fn cone_marching_finds_the_surface_every_ray_finds() {
             "{name}: cone {} vs plain {} bound evaluations",
             cone.stats.coarse_evals,
             plain.stats.coarse_evals
+        );
+    }
+}
+
+#[test]
+fn neighbours_balls_find_the_surface_every_ray_finds() {
+    for name in THIN {
+        let (shared, own) = same_surface(name, |o| TracerOptions {
+            neighbours: false,
+            ..o
+        });
+        // The point of it: fewer evaluations per ray in all.
+        let all = |r: &Rendered| r.stats.evals + r.stats.coarse_evals;
+        assert!(
+            all(&shared) < all(&own),
+            "{name}: with the neighbours' balls {} vs without {} evaluations",
+            all(&shared),
+            all(&own)
         );
     }
 }

@@ -14,8 +14,10 @@
 //! of the scene's field), so the guarantee is the same as the per-ray steps'. When the
 //! cone radius eats more than half of the step, the tile splits into four and each
 //! quarter goes on from the same `t` with its narrower cone; single pixels (and tiles
-//! whose cone no longer advances) are traced ray by ray from the tile's `t`.
+//! whose cone no longer advances) are traced ray by ray from the tile's `t`, each past
+//! the empty balls of the tile's rays traced just before it (`render::neighbours`).
 
+use super::neighbours::Neighbours;
 use super::tracer::{RayResult, RayStats, Tracer};
 use crate::camera::Camera;
 use glam::DVec3;
@@ -86,15 +88,41 @@ pub fn trace_tile(
     out: &mut dyn FnMut(u32, u32, RayResult),
 ) {
     if !cone || tracer.options().coarse_beta <= 0.0 {
-        for py in tile.y0..tile.y0 + tile.h {
-            for px in tile.x0..tile.x0 + tile.w {
-                let (o, d) = ray(camera, px, py, sub);
-                out(px, py, tracer.trace(o, d, t_start));
-            }
-        }
-        return;
+        return trace_rays(tracer, camera, tile, sub, t_start, None, out);
     }
-    march(tracer, camera, tile, sub, t_start, stats, out);
+    let mut near = tracer.options().neighbours.then(Neighbours::new);
+    let mut march = March {
+        tracer,
+        camera,
+        sub,
+        stats,
+        near: near.as_mut(),
+        out,
+    };
+    march.tile(tile, t_start);
+}
+
+/// Traces every pixel of `tile` ray by ray from `t_start`, each past its neighbours'
+/// balls if `near` is given.
+fn trace_rays(
+    tracer: &Tracer,
+    camera: &Camera,
+    tile: Tile,
+    sub: [f64; 2],
+    t_start: f64,
+    mut near: Option<&mut Neighbours>,
+    out: &mut dyn FnMut(u32, u32, RayResult),
+) {
+    for py in tile.y0..tile.y0 + tile.h {
+        for px in tile.x0..tile.x0 + tile.w {
+            let (o, d) = ray(camera, px, py, sub);
+            let r = match near.as_deref_mut() {
+                Some(n) => tracer.trace_near(o, d, t_start, n),
+                None => tracer.trace(o, d, t_start),
+            };
+            out(px, py, r);
+        }
+    }
 }
 
 /// The ray of pixel `(px, py)` through its sub-pixel position `sub`.
@@ -102,60 +130,81 @@ fn ray(camera: &Camera, px: u32, py: u32, sub: [f64; 2]) -> (DVec3, DVec3) {
     camera.ray_through(f64::from(px) + sub[0], f64::from(py) + sub[1])
 }
 
-fn march(
-    tracer: &Tracer,
-    camera: &Camera,
-    tile: Tile,
+/// A tile's march: its quarters recursively, then ray by ray.
+struct March<'m, 't> {
+    tracer: &'m Tracer<'t>,
+    camera: &'m Camera,
     sub: [f64; 2],
-    t_start: f64,
-    stats: &mut ConeStats,
-    out: &mut dyn FnMut(u32, u32, RayResult),
-) {
-    if tile.w < MIN_TILE || tile.h < MIN_TILE {
-        return trace_tile(tracer, camera, tile, sub, t_start, false, stats, out);
-    }
-    let (o, _) = ray(camera, tile.x0, tile.y0, sub);
-    let (x1, y1) = (tile.x0 + tile.w - 1, tile.y0 + tile.h - 1);
-    let corners = [(tile.x0, tile.y0), (x1, tile.y0), (tile.x0, y1), (x1, y1)]
-        .map(|(px, py)| ray(camera, px, py, sub).1);
-    let axis = corners.iter().copied().sum::<DVec3>().normalize();
-    // |d_i - a| for the widest ray: the cone radius per unit of t.
-    let spread = corners
-        .iter()
-        .map(|&d| (d - axis).length())
-        .fold(0.0, f64::max);
-    // Start from the camera's own clearance (every ray's start) and let the march skip
-    // the empty space before the scene box.
-    let mut t = t_start;
-    let t_far = tracer.farthest(o);
-    let beta = tracer.options().coarse_beta;
-    let mut advanced = false;
-    while t <= t_far {
-        let mut ray = RayStats::default();
-        let r = tracer.bound(o + t * axis, beta, &mut ray);
-        stats.evals += ray.coarse_evals as u64;
-        stats.leaves += ray.eval.leaves() as u64;
-        stats.nodes += ray.eval.nodes as u64;
-        let step = r - spread * t;
-        if step.is_nan() || step <= MIN_STEP_SHARE * r {
-            break;
+    stats: &'m mut ConeStats,
+    /// The balls of the tile's last rays (`render::neighbours`), if used.
+    near: Option<&'m mut Neighbours>,
+    out: &'m mut dyn FnMut(u32, u32, RayResult),
+}
+
+impl March<'_, '_> {
+    /// Marches `tile` from `t_start` and traces its rays.
+    fn tile(&mut self, tile: Tile, t_start: f64) {
+        if tile.w < MIN_TILE || tile.h < MIN_TILE {
+            return self.rays(tile, t_start);
         }
-        t += step;
-        advanced = true;
-    }
-    if t > t_far {
-        // Past every ray's exit from the scene box: all of them miss.
-        for py in tile.y0..tile.y0 + tile.h {
-            for px in tile.x0..tile.x0 + tile.w {
-                out(px, py, RayResult::default());
+        let (tracer, sub) = (self.tracer, self.sub);
+        let (o, _) = ray(self.camera, tile.x0, tile.y0, sub);
+        let (x1, y1) = (tile.x0 + tile.w - 1, tile.y0 + tile.h - 1);
+        let corners = [(tile.x0, tile.y0), (x1, tile.y0), (tile.x0, y1), (x1, y1)]
+            .map(|(px, py)| ray(self.camera, px, py, sub).1);
+        let axis = corners.iter().copied().sum::<DVec3>().normalize();
+        // |d_i - a| for the widest ray: the cone radius per unit of t.
+        let spread = corners
+            .iter()
+            .map(|&d| (d - axis).length())
+            .fold(0.0, f64::max);
+        // Start from the camera's own clearance (every ray's start) and let the march skip
+        // the empty space before the scene box.
+        let mut t = t_start;
+        let t_far = tracer.farthest(o);
+        let beta = tracer.options().coarse_beta;
+        let mut advanced = false;
+        while t <= t_far {
+            let mut ray = RayStats::default();
+            let r = tracer.bound(o + t * axis, beta, &mut ray);
+            self.stats.evals += ray.coarse_evals as u64;
+            self.stats.leaves += ray.eval.leaves() as u64;
+            self.stats.nodes += ray.eval.nodes as u64;
+            let step = r - spread * t;
+            if step.is_nan() || step <= MIN_STEP_SHARE * r {
+                break;
             }
+            t += step;
+            advanced = true;
         }
-        return;
+        if t > t_far {
+            // Past every ray's exit from the scene box: all of them miss.
+            for py in tile.y0..tile.y0 + tile.h {
+                for px in tile.x0..tile.x0 + tile.w {
+                    (self.out)(px, py, RayResult::default());
+                }
+            }
+            return;
+        }
+        if !advanced && tile.w <= 2 * MIN_TILE && tile.h <= 2 * MIN_TILE {
+            return self.rays(tile, t);
+        }
+        for q in tile.quarters() {
+            self.tile(q, t);
+        }
     }
-    if !advanced && tile.w <= 2 * MIN_TILE && tile.h <= 2 * MIN_TILE {
-        return trace_tile(tracer, camera, tile, sub, t, false, stats, out);
-    }
-    for q in tile.quarters() {
-        march(tracer, camera, q, sub, t, stats, out);
+
+    /// Traces the rays of `tile` one by one from `t_start`.
+    fn rays(&mut self, tile: Tile, t_start: f64) {
+        let near = self.near.as_deref_mut();
+        trace_rays(
+            self.tracer,
+            self.camera,
+            tile,
+            self.sub,
+            t_start,
+            near,
+            self.out,
+        );
     }
 }

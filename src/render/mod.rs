@@ -1,6 +1,7 @@
 //! Rendering: objects ready to trace, the sphere tracer (SPEC 7), the image loop.
 
 pub mod cone;
+pub mod neighbours;
 pub mod object;
 mod stepper;
 pub mod tracer;

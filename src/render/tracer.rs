@@ -24,7 +24,8 @@
 //!    minus the gap clears twice the threshold (near a soft point cloud the coarse sum
 //!    is several epsilons low, and a bound step there would only fall through again).
 //!    Primary rays reach this loop after their tile's cone march (`render::cone`), which
-//!    takes the far steps once for a whole tile.
+//!    takes the far steps once for a whole tile, and start past the stretch that the
+//!    empty balls of the tile's last rays already certify (`render::neighbours`).
 //! 6. Full-accuracy evaluations prune with a tolerance tied to epsilon: subtrees whose
 //!    terms hold together less than `tol = min(0.005 alpha epsilon, 1e-3)` of the sum are
 //!    skipped and covered from above, which lowers `s` by at most `2 tol / alpha`, 1% of
@@ -57,6 +58,7 @@
 //!     too, so the step is safe, at 60-75% of the terms near the surface; a value in
 //!     the hit band or below is taken again at the hit beta before it decides anything.
 
+use super::neighbours::Neighbours;
 use super::object::TraceObject;
 use super::stepper::{Kind, Stepper};
 use crate::eval::EvalStats;
@@ -79,6 +81,9 @@ pub struct TracerOptions {
     pub coarse_threshold: f64,
     /// March primary-ray tiles as cones first (`cone`; needs `coarse_beta > 0`).
     pub cone: bool,
+    /// Within a cone-marched tile, start each ray past the empty balls of the rays traced
+    /// just before it (`render::neighbours`; needs `cone`).
+    pub neighbours: bool,
     /// Over-relaxed steps, each certified by the next sample's value (see `Stepper`).
     pub relax: bool,
     /// Hits on objects with edges or triangles are decided at this share of the scene's
@@ -117,6 +122,7 @@ impl TracerOptions {
             coarse_beta: 4.0,
             coarse_threshold: 4.0,
             cone: true,
+            neighbours: true,
             relax: true,
             hit_beta_scale: 0.6,
             step_beta: 1.0,
@@ -133,6 +139,7 @@ impl TracerOptions {
         TracerOptions {
             coarse_beta: 0.0,
             cone: false,
+            neighbours: false,
             relax: false,
             hit_beta_scale: 1.0,
             step_beta: 0.0,
@@ -438,6 +445,25 @@ impl<'a> Tracer<'a> {
 
     /// Traces the ray from `o` along unit `d`, starting no earlier than `t_start`.
     pub fn trace(&self, o: DVec3, d: DVec3, t_start: f64) -> RayResult {
+        self.trace_impl(o, d, t_start, None)
+    }
+
+    /// [`Tracer::trace`] for a ray of a tile: it starts past the stretch that the empty
+    /// balls of the tile's last rays certify, and leaves its own balls for the next
+    /// (`render::neighbours`).
+    pub fn trace_near(&self, o: DVec3, d: DVec3, t_start: f64, near: &mut Neighbours) -> RayResult {
+        let r = self.trace_impl(o, d, t_start, Some(&mut *near));
+        near.finish_ray();
+        r
+    }
+
+    fn trace_impl(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        t_start: f64,
+        mut balls: Option<&mut Neighbours>,
+    ) -> RayResult {
         let mut stats = RayStats::default();
         let eps = self.options.epsilon;
         // The zero set at the object's own alpha lies inside the grown box in both
@@ -452,6 +478,9 @@ impl<'a> Tracer<'a> {
             (0.0, (o - c).length() + 0.5 * (self.max - self.min).length())
         };
         let mut t = t_enter.max(t_start);
+        if let Some(n) = balls.as_deref_mut() {
+            t = n.start(o, d, t);
+        }
         // The last certified sample: (t, a lower bound of the field there, the free
         // distance from it). Everything up to `t + free` is free of the surface.
         let mut prev: Option<(f64, f64, f64)> = None;
@@ -482,6 +511,9 @@ impl<'a> Tracer<'a> {
             if let (Some(beta), false) = (coarse, near) {
                 let c = self.sample(x, &mut stats, Want::Bound(beta), false, None);
                 if c.s > eps {
+                    if let Some(n) = balls.as_deref_mut() {
+                        n.note(x, c.s);
+                    }
                     // Outside the hit band the bound's own step is safe: taken here even
                     // when the value fell below the threshold (a full value at this
                     // point could not hit either, and where the bound is tight it would
@@ -554,6 +586,9 @@ impl<'a> Tracer<'a> {
                     None => Some(self.hit(o, d, t, &f, &mut stats)),
                 };
                 return RayResult { hit, stats };
+            }
+            if let Some(n) = balls.as_deref_mut() {
+                n.note(x, f.s);
             }
             let step = stepper.step(prev, t, f.s, f.reach, Kind::Full);
             // The value at the next sample, if the field keeps its slope along the ray.
