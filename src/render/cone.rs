@@ -164,9 +164,12 @@ impl March<'_, '_> {
         let t_far = tracer.farthest(o);
         let beta = tracer.options().coarse_beta;
         let mut advanced = false;
+        // The last axis sample: its ball outlasts the march (`render::neighbours`).
+        let mut last = None;
         while t <= t_far {
             let mut ray = RayStats::default();
             let r = tracer.bound(o + t * axis, beta, &mut ray);
+            last = Some((o + t * axis, r));
             self.stats.evals += ray.coarse_evals as u64;
             self.stats.leaves += ray.eval.leaves() as u64;
             self.stats.nodes += ray.eval.nodes as u64;
@@ -186,11 +189,19 @@ impl March<'_, '_> {
             }
             return;
         }
+        let mark = match (self.near.as_deref_mut(), last) {
+            (Some(n), Some((x, r))) => Some(n.enter_cone(x, r)),
+            _ => None,
+        };
         if !advanced && tile.w <= 2 * MIN_TILE && tile.h <= 2 * MIN_TILE {
-            return self.rays(tile, t);
+            self.rays(tile, t);
+        } else {
+            for q in tile.quarters() {
+                self.tile(q, t);
+            }
         }
-        for q in tile.quarters() {
-            self.tile(q, t);
+        if let (Some(n), Some(mark)) = (self.near.as_deref_mut(), mark) {
+            n.leave_cone(mark);
         }
     }
 

@@ -16,6 +16,9 @@
 //! have values of 3-10 epsilons: the balls of the rays traced just before (the tile's
 //! quarters are traced in Z order, so these are mostly the pixels to the left and above)
 //! carry a ray past most of its bound steps and often its first full evaluation.
+//! The last axis sample of each cone march that encloses the ray (`render::cone`) is a
+//! ball too: the march stops where the cone's radius eats half of its value, but a ray
+//! off the axis by `c` still meets that ball on a chord of half-length `sqrt(s^2 - c^2)`.
 //! Only balls of the same tile and sample pass are used, so a render does not depend on
 //! how tiles are spread over threads (and a crop traces its tiles as the whole image does).
 //! The free distance along a ray (`eval::reach`) certifies that ray only, and is not kept.
@@ -45,6 +48,9 @@ pub struct Neighbours {
     counts: std::collections::VecDeque<usize>,
     /// Balls of the ray being traced.
     current: Vec<Ball>,
+    /// Balls of the cone marches enclosing the rays being traced (a stack: one per
+    /// level of the tile's quarters).
+    cones: Vec<Ball>,
     /// Scratch: chords of the kept balls on the ray being started.
     chords: Vec<(f64, f64)>,
 }
@@ -58,7 +64,7 @@ impl Neighbours {
     /// a chain of the kept balls (`t0` if no ball contains it).
     pub fn start(&mut self, o: DVec3, d: DVec3, t0: f64) -> f64 {
         self.chords.clear();
-        for b in &self.balls {
+        for b in self.balls.iter().chain(&self.cones) {
             let r = b.radius * (1.0 - RADIUS_MARGIN);
             let tc = (b.centre - o).dot(d);
             let off2 = (b.centre - o - tc * d).length_squared();
@@ -88,6 +94,24 @@ impl Neighbours {
                 radius: s,
             });
         }
+    }
+
+    /// Enters a cone march's sub-tiles: the field is at least `s` at `x` on its axis.
+    /// Returns the mark to [`Neighbours::leave_cone`] with.
+    pub fn enter_cone(&mut self, x: DVec3, s: f64) -> usize {
+        let mark = self.cones.len();
+        if s > 0.0 {
+            self.cones.push(Ball {
+                centre: x,
+                radius: s,
+            });
+        }
+        mark
+    }
+
+    /// Leaves the cone march entered with `mark`.
+    pub fn leave_cone(&mut self, mark: usize) {
+        self.cones.truncate(mark);
     }
 
     /// Ends the ray being traced: its balls are kept, the oldest ray's dropped.
@@ -130,6 +154,27 @@ mod tests {
         assert_eq!(n.start(o, d, 20.0), 20.0);
         // A ray farther than the radius meets no ball.
         assert_eq!(n.start(DVec3::new(-10.0, 1.4, 0.0), d, 10.0), 10.0);
+    }
+
+    #[test]
+    fn cone_balls_last_until_their_march_is_left() {
+        let mut n = Neighbours::new();
+        let (o, d) = (DVec3::ZERO, DVec3::Z);
+        let outer = n.enter_cone(DVec3::new(0.0, 0.0, 10.0), 2.0);
+        let inner = n.enter_cone(DVec3::new(0.1, 0.0, 11.5), 1.0);
+        // A ray's own balls come and go; the cones' stay.
+        n.note(DVec3::new(0.0, 0.0, 50.0), 1.0);
+        n.finish_ray();
+        let t = n.start(o, d, 9.0);
+        assert!((t - (11.5 + (1.0f64 - 0.01).sqrt())).abs() < 1e-6, "{t}");
+        n.leave_cone(inner);
+        assert!((n.start(o, d, 9.0) - 12.0).abs() < 1e-6);
+        n.leave_cone(outer);
+        assert_eq!(n.start(o, d, 9.0), 9.0);
+        // A march whose axis value certifies nothing pushes no ball.
+        let mark = n.enter_cone(DVec3::ZERO, f64::NAN);
+        assert!(n.cones.is_empty());
+        n.leave_cone(mark);
     }
 
     #[test]
