@@ -11,11 +11,12 @@
 //! chord contains `t0`, `t0` moves to the chord's end. The chords so chained are inside
 //! the balls, so the skipped stretch is as safe as the tracer's own steps.
 //!
-//! Primary rays of neighbouring pixels are a pixel's footprint apart (at the surface, a
-//! few epsilons at 1920x1080 on the lidar scan), while the last full samples before a hit
-//! have values of 3-10 epsilons: the balls of the rays traced just before (the tile's
-//! quarters are traced in Z order, so these are mostly the pixels to the left and above)
-//! carry a ray past most of its bound steps and often its first full evaluation.
+//! Primary rays of neighbouring pixels are a pixel's footprint apart at the surface
+//! (about 6 epsilons at 1920x1080 at the centre of the lidar scan), and the samples
+//! before a hit have values of a few to tens of epsilons: the balls of the rays traced
+//! just before (the tile's quarters are traced in Z order, so these are mostly the
+//! pixels to the left and above) carry a ray past some of its bound steps and often its
+//! first full evaluation (README, round eight).
 //! The last axis sample of each cone march that encloses the ray (`render::cone`) is a
 //! ball too: the march stops where the cone's radius eats half of its value, but a ray
 //! off the axis by `c` still meets that ball on a chord of half-length `sqrt(s^2 - c^2)`.
