@@ -214,7 +214,7 @@ fn main() {
             }
         }
         let mut p = obj.params;
-        p.prune_tolerance = (0.005 * p.alpha * eps).min(1e-3);
+        p.prune_tolerance = (0.005 * p.alpha * eps).min(1e-2);
         let eval = |mode: usize, x: DVec3, d: DVec3| match mode {
             0 => evaluate_value(&sets, x, &p).s,
             1 => smoothtrace::eval::evaluate_reach(&sets, x, d, &p, 1e9, false).reach,
@@ -248,7 +248,7 @@ fn main() {
     if args.get(4).map(String::as_str) == Some("evalstats") {
         let mut sum = [0f64; 5];
         let mut n = 0.0;
-        let tol = (0.005 * obj.params.alpha * eps).min(1e-3);
+        let tol = (0.005 * obj.params.alpha * eps).min(1e-2);
         for py in (0..h).step_by(2) {
             for px in (0..w).step_by(2) {
                 let (o, d) = cam.ray(px, py);

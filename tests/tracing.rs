@@ -254,7 +254,7 @@ fn tracer_pruning_tolerance_keeps_a_close_lower_bound() {
     .unwrap();
     let mut rng = common::Rng::new(11);
     for alpha in [5.0, 40.0, 300.0] {
-        for tol in [1e-10, 1e-6, 1e-3] {
+        for tol in [1e-10, 1e-6, 1e-3, 1e-2] {
             let mut p = EvalParams::new(alpha, alpha, 0.0);
             p.prune_tolerance = tol;
             for _ in 0..200 {
