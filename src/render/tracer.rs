@@ -15,8 +15,10 @@
 //!    Illinois (safeguarded regula falsi) method to within `epsilon`.
 //! 5. Far from the surface, steps are bound steps: a coarser Barnes-Hut sum
 //!    (`coarse_beta`, cheaper, and a lower bound of the scene's sum, so the steps stay
-//!    safe) until it falls below `coarse_threshold * epsilon`; from there on the scene's
-//!    own beta decides the hit. The bound value that falls through is still a safe step
+//!    safe) until it falls below `coarse_threshold * epsilon` (`coarse_threshold_points`
+//!    when every object is a point cloud: their full steps are made at the cheaper step
+//!    beta, item 10, so they take over earlier); from there on the scene's own beta
+//!    decides the hit. The bound value that falls through is still a safe step
 //!    when it is above epsilon (no full value there could hit), and it is taken: on
 //!    edges and triangles the coarse sum is nearly exact, and a full evaluation at the
 //!    same point would only repeat it. The gap between that bound value and the full
@@ -81,6 +83,9 @@ pub struct TracerOptions {
     pub coarse_beta: f64,
     /// Coarse steps are taken while the coarse value exceeds this many epsilons.
     pub coarse_threshold: f64,
+    /// The same where every object is made of points only (their full steps are made at
+    /// `step_beta`, so a full step pays off earlier).
+    pub coarse_threshold_points: f64,
     /// March primary-ray tiles as cones first (`cone`; needs `coarse_beta > 0`).
     pub cone: bool,
     /// Within a cone-marched tile, start each ray past the empty balls of the rays traced
@@ -123,6 +128,7 @@ impl TracerOptions {
             max_steps,
             coarse_beta: 4.0,
             coarse_threshold: 4.0,
+            coarse_threshold_points: 8.0,
             cone: true,
             neighbours: true,
             relax: true,
@@ -238,6 +244,8 @@ pub struct Tracer<'a> {
     /// the first evaluation at the hit beta on, the ray's full evaluations stay there
     /// (the scene's beta is several epsilons low near their surfaces, item 9).
     sticky: bool,
+    /// Bound steps are taken while the bound value exceeds this (item 5).
+    tau: f64,
     /// Union of the grown object boxes.
     min: DVec3,
     max: DVec3,
@@ -284,6 +292,15 @@ impl<'a> Tracer<'a> {
             })
             .collect();
         let refine = step_beta.iter().zip(&hit_beta).any(|(s, h)| s != h);
+        let all_points = objects
+            .iter()
+            .all(|o| o.sets.iter().all(|s| matches!(s, AnySet::Points(_))));
+        let tau = options.epsilon
+            * if all_points {
+                options.coarse_threshold_points
+            } else {
+                options.coarse_threshold
+            };
         let sticky = objects
             .iter()
             .zip(&hit_beta)
@@ -297,6 +314,7 @@ impl<'a> Tracer<'a> {
             step_beta,
             refine,
             sticky,
+            tau,
             min,
             max,
             options,
@@ -488,7 +506,7 @@ impl<'a> Tracer<'a> {
         let mut prev: Option<(f64, f64, f64)> = None;
         let mut stepper = Stepper::new(self.options.relax);
         let coarse = (self.options.coarse_beta > 0.0).then_some(self.options.coarse_beta);
-        let tau = self.options.coarse_threshold * eps;
+        let tau = self.tau;
         let mut near = false;
         // How far the bound step's value fell below the full value that followed it
         // (module docs, item 5; at the next point, so about the gap there): a bound step
