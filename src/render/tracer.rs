@@ -265,16 +265,17 @@ impl<'a> Tracer<'a> {
             .iter()
             .map(|o| (0.005 * o.params.alpha * options.epsilon).min(1e-2))
             .collect();
-        // Point clouds keep the scene's beta for hits (item 9).
+        // Objects made of points only: hits at the scene's beta (item 9), coarser steps
+        // (item 10) and an earlier end of the bound steps (item 5).
+        let points_only: Vec<bool> = objects
+            .iter()
+            .map(|o| o.sets.iter().all(|s| matches!(s, AnySet::Points(_))))
+            .collect();
         let hit_beta: Vec<f64> = objects
             .iter()
-            .map(|o| {
-                let points_only = o.sets.iter().all(|s| matches!(s, AnySet::Points(_)));
-                let scale = if points_only {
-                    1.0
-                } else {
-                    options.hit_beta_scale
-                };
+            .zip(&points_only)
+            .map(|(o, &points)| {
+                let scale = if points { 1.0 } else { options.hit_beta_scale };
                 o.params.beta * scale.clamp(0.0, 1.0)
             })
             .collect();
@@ -282,9 +283,9 @@ impl<'a> Tracer<'a> {
         // is already several epsilons low near the surface, item 9).
         let step_beta: Vec<f64> = objects
             .iter()
-            .map(|o| {
-                let points_only = o.sets.iter().all(|s| matches!(s, AnySet::Points(_)));
-                if points_only {
+            .zip(&points_only)
+            .map(|(o, &points)| {
+                if points {
                     o.params.beta.max(options.step_beta)
                 } else {
                     o.params.beta
@@ -292,11 +293,8 @@ impl<'a> Tracer<'a> {
             })
             .collect();
         let refine = step_beta.iter().zip(&hit_beta).any(|(s, h)| s != h);
-        let all_points = objects
-            .iter()
-            .all(|o| o.sets.iter().all(|s| matches!(s, AnySet::Points(_))));
         let tau = options.epsilon
-            * if all_points {
+            * if points_only.iter().all(|&p| p) {
                 options.coarse_threshold_points
             } else {
                 options.coarse_threshold
