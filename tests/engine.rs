@@ -547,18 +547,25 @@ fn moment_far_fields_are_conservative_and_tighter_than_boxes() {
                     );
                     // The free distance along a ray (eval::reach) holds with moment terms:
                     // the exact value stays positive over it.
+                    // So does the free distance behind (asked for up to the diagonal).
                     let u = rng.unit();
-                    let r = eval::evaluate_reach(&[&set], x, u, &p, diag, false);
-                    if exact > 0.0 && r.reach > r.s {
+                    let along = eval::Along {
+                        u,
+                        max_len: diag,
+                        back: diag,
+                    };
+                    let r = eval::evaluate_along(&[&set], x, Some(along), &p, false);
+                    if exact > 0.0 && r.reach.max(r.reach_back) > r.s {
                         for k in 1..=8 {
-                            let t = r.reach * k as f64 / 8.0;
-                            let (e, _, _) =
-                                brute::smooth_distance(&[&set], x + t * u, alpha, alpha);
-                            assert!(
-                                e >= -1e-12 * s_scale(e, alpha),
-                                "{name} alpha*diag {ad} beta {beta}: exact {e} at {t} of free {}",
-                                r.reach
-                            );
+                            for (free, sign) in [(r.reach, 1.0), (r.reach_back, -1.0)] {
+                                let t = sign * free * k as f64 / 8.0;
+                                let (e, _, _) =
+                                    brute::smooth_distance(&[&set], x + t * u, alpha, alpha);
+                                assert!(
+                                    e >= -1e-12 * s_scale(e, alpha),
+                                    "{name} alpha*diag {ad} beta {beta}: exact {e} at {t} of free {free}",
+                                );
+                            }
                         }
                     }
                     if ad <= 30.0 && beta == 1.0 && exact - sb > 1e-6 / alpha {

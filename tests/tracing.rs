@@ -8,7 +8,9 @@
 //!   tubes, the bucky ball's struts, the spiky sphere's spikes) are where a skipped
 //!   surface would show. Over-relaxed steps (`TracerOptions::relax`) likewise against
 //!   plain sphere-tracing steps, steps by the free distance from the terms' slopes
-//!   (`TracerOptions::reach_steps`, point clouds) against plain steps, and rays started
+//!   (`TracerOptions::reach_steps`, point clouds) against plain steps, relaxed steps
+//!   certified by the free distance behind the next sample (`TracerOptions::reach_behind`,
+//!   point clouds) against its ball alone, and rays started
 //!   past their neighbours' empty balls (`TracerOptions::neighbours`) against rays that
 //!   only use their own.
 //! - At beta 0.5 the rendered surface stays close to the exact (beta 0) one: median depth
@@ -133,8 +135,9 @@ fn relaxed_steps_find_the_surface_plain_steps_find() {
     }
 }
 
-#[test]
-fn reach_steps_find_the_surface_plain_steps_find() {
+/// The point-cloud scenes: the procedural sphere of points, and the bunny's and the
+/// deer's points when their data files are there.
+fn point_scenes() -> Vec<&'static str> {
     let mut names = vec!["sphere_points.toml"];
     if common::data_file("bunny-7k.obj").is_some() {
         names.push("bunny_points.toml");
@@ -146,6 +149,33 @@ fn reach_steps_find_the_surface_plain_steps_find() {
     } else {
         eprintln!("skipping deer_alpha1.toml: data/igea-points-134k.ply is absent");
     }
+    names
+}
+
+#[test]
+fn relaxed_steps_certified_from_behind_find_the_surface_on_point_clouds() {
+    for name in point_scenes() {
+        let (behind, ball) = same_surface(name, |o| TracerOptions {
+            reach_behind: false,
+            ..o
+        });
+        // The point of it: fewer relaxed steps given up (each costs an evaluation).
+        eprintln!(
+            "{name}: rejected steps {} -> {}",
+            ball.stats.rejected_steps, behind.stats.rejected_steps
+        );
+        assert!(
+            behind.stats.rejected_steps < ball.stats.rejected_steps,
+            "{name}: {} rejected steps certified from behind, {} by the ball alone",
+            behind.stats.rejected_steps,
+            ball.stats.rejected_steps
+        );
+    }
+}
+
+#[test]
+fn reach_steps_find_the_surface_plain_steps_find() {
+    let names = point_scenes();
     let plain = |o| TracerOptions {
         reach_steps: false,
         ..o

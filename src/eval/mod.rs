@@ -19,5 +19,5 @@ pub mod walk;
 pub use accumulate::Accumulation;
 pub use nearest::{Nearest, nearest};
 pub use smooth::{
-    EvalParams, EvalStats, Sample, evaluate, evaluate_along, evaluate_reach, evaluate_value,
+    Along, EvalParams, EvalStats, Sample, evaluate, evaluate_along, evaluate_reach, evaluate_value,
 };

@@ -25,6 +25,11 @@
 //! less on Barnes-Hut sums, whose far-field slopes are bunched: 5.2 instead of 4.8 full
 //! evaluations per hit ray on the deer, and more instructions in all.)
 //!
+//! The same bins give the free distance backwards, along `-u`: every slope negated, the
+//! bins mirrored ([`Slopes::reversed`]). The tracer uses it to certify an over-relaxed
+//! step from the far end (`render::stepper`): near a surface met at an angle the field
+//! grows going back along the ray, so that reach is often several times `s`.
+//!
 //! Where all terms come at slope -1 (the ray heads straight at everything) this gives
 //! back the plain sphere-tracing step `s`; where the terms that matter are met at a
 //! grazing angle, or spread in direction, it certifies much longer steps. Only for sets
@@ -63,6 +68,17 @@ impl Slopes {
             self.mass[k] *= f;
             self.moment[k] *= f;
         }
+    }
+
+    /// The same terms seen along `-u`: every slope negated, so the bins are mirrored
+    /// (the pruned mass stays at slope -1, as `free_distance` counts it).
+    pub fn reversed(&self) -> Slopes {
+        let mut r = Slopes::default();
+        for k in 0..BINS {
+            r.mass[k] = self.mass[BINS - 1 - k];
+            r.moment[k] = -self.moment[BINS - 1 - k];
+        }
+        r
     }
 
     /// The chord coefficients `c_k` of the bin edges `a_k = -1 + k WIDTH`, with the
@@ -162,7 +178,7 @@ mod tests {
     }
 
     #[test]
-    fn free_distance_never_passes_a_zero_and_beats_the_plain_step() {
+    fn free_distance_ahead_and_behind_never_passes_a_zero_and_beats_the_plain_step() {
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
         let mut rnd = move || {
             seed ^= seed << 13;
@@ -170,7 +186,7 @@ mod tests {
             seed ^= seed << 17;
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        let (mut gain, mut cases) = (0.0, 0);
+        let (mut gain, mut gain_back, mut cases) = (0.0, 0.0, 0);
         for _ in 0..400 {
             let alpha = [0.5, 2.0, 10.0, 50.0][(rnd() * 4.0) as usize];
             // A cloud around the origin, a ray from outside towards it (or past it).
@@ -224,6 +240,11 @@ mod tests {
             };
             let free = slopes.free_distance(s, m, alpha, pruned, 100.0 * s);
             assert!(free >= s, "free {free} below the plain step {s}");
+            // Behind: the mirrored bins, checked along -u.
+            let back = slopes
+                .reversed()
+                .free_distance(s, m, alpha, pruned, 100.0 * s);
+            assert!(back >= s, "free behind {back} below the plain step {s}");
             for k in 0..=200 {
                 let l = free * k as f64 / 200.0;
                 let v = exact(&points, x, u, l, alpha);
@@ -231,14 +252,28 @@ mod tests {
                     v > -1e-9 * s,
                     "negative {v} at {l} of free distance {free} (s {s})"
                 );
+                let l = back * k as f64 / 200.0;
+                let v = exact(&points, x, u, -l, alpha);
+                assert!(
+                    v > -1e-9 * s,
+                    "negative {v} at {l} behind, free distance {back} (s {s})"
+                );
             }
             gain += free / s;
+            gain_back += back / s;
             cases += 1;
         }
         assert!(cases > 100, "{cases} cases");
         assert!(
             gain / cases as f64 > 1.2,
             "mean free / s = {}",
+            gain / cases as f64
+        );
+        // The rays head down into the cloud: behind them the field grows.
+        assert!(
+            gain_back > gain,
+            "mean free / s: behind {} against ahead {}",
+            gain_back / cases as f64,
             gain / cases as f64
         );
     }

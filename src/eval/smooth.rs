@@ -152,6 +152,9 @@ pub struct Sample {
     /// Free distance along the direction given to [`evaluate_reach`]: the smooth
     /// distance stays positive on `x + [0, reach] u` (`eval::reach`); `s` otherwise.
     pub reach: f64,
+    /// Free distance backwards, on `x - [0, reach_back] u`, when asked for by
+    /// [`Along::back`] and `s` is below it (at most that length); `s` otherwise.
+    pub reach_back: f64,
     pub stats: EvalStats,
 }
 
@@ -212,13 +215,36 @@ pub(crate) fn bennett_g_chord(z: f64) -> f64 {
 
 /// Evaluates the smooth distance of the union of `sets` at `x`, with its gradient.
 pub fn evaluate(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
-    evaluate_impl::<true, false>(sets, x, DVec3::ZERO, p, 0.0)
+    evaluate_impl::<true, false>(sets, x, Along::ahead(DVec3::ZERO, 0.0), p)
 }
 
 /// Evaluates the smooth distance only (the returned gradient is zero): what a sphere
 /// tracer needs for its steps, at about half the cost.
 pub fn evaluate_value(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
-    evaluate_impl::<false, false>(sets, x, DVec3::ZERO, p, 0.0)
+    evaluate_impl::<false, false>(sets, x, Along::ahead(DVec3::ZERO, 0.0), p)
+}
+
+/// A ray through the evaluation point, for free distances along it (`eval::reach`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Along {
+    /// Unit direction.
+    pub u: DVec3,
+    /// The free distance ahead is wanted up to this length.
+    pub max_len: f64,
+    /// The free distance behind is wanted up to this length: computed only where `s` is
+    /// shorter (0: not wanted).
+    pub back: f64,
+}
+
+impl Along {
+    /// Ahead only, up to `max_len`.
+    pub fn ahead(u: DVec3, max_len: f64) -> Along {
+        Along {
+            u,
+            max_len,
+            back: 0.0,
+        }
+    }
 }
 
 /// Evaluates the smooth distance (with the gradient if `grad`) and how far along the
@@ -233,25 +259,26 @@ pub fn evaluate_reach(
     max_len: f64,
     grad: bool,
 ) -> Sample {
-    evaluate_along(sets, x, Some((u, max_len)), p, grad)
+    evaluate_along(sets, x, Some(Along::ahead(u, max_len)), p, grad)
 }
 
-/// The general evaluation: with the gradient if `grad`, and with the free distance
-/// along `along = (u, max_len)` if given (as [`evaluate_reach`]).
+/// The general evaluation: with the gradient if `grad`, and with the free distances
+/// along a ray if `along` is given (as [`evaluate_reach`], and behind as asked).
 pub fn evaluate_along(
     sets: &[&AnySet],
     x: DVec3,
-    along: Option<(DVec3, f64)>,
+    along: Option<Along>,
     p: &EvalParams,
     grad: bool,
 ) -> Sample {
     let points = sets.iter().all(|s| matches!(s, AnySet::Points(_)));
     let slope = points && p.accumulation == Accumulation::Stable;
+    let none = Along::ahead(DVec3::ZERO, 0.0);
     match (along.filter(|_| slope), grad) {
-        (Some((u, len)), true) => evaluate_impl::<true, true>(sets, x, u, p, len),
-        (Some((u, len)), false) => evaluate_impl::<false, true>(sets, x, u, p, len),
-        (None, true) => evaluate_impl::<true, false>(sets, x, DVec3::ZERO, p, 0.0),
-        (None, false) => evaluate_impl::<false, false>(sets, x, DVec3::ZERO, p, 0.0),
+        (Some(a), true) => evaluate_impl::<true, true>(sets, x, a, p),
+        (Some(a), false) => evaluate_impl::<false, true>(sets, x, a, p),
+        (None, true) => evaluate_impl::<true, false>(sets, x, none, p),
+        (None, false) => evaluate_impl::<false, false>(sets, x, none, p),
     }
 }
 
@@ -271,10 +298,10 @@ pub(crate) fn prune_margin(sets: &[&AnySet], p: &EvalParams, tol: f64) -> f64 {
 fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
     sets: &[&AnySet],
     x: DVec3,
-    u: DVec3,
+    along: Along,
     p: &EvalParams,
-    max_len: f64,
 ) -> Sample {
+    let u = along.u;
     let mut acc = Accumulator::new(p.alpha, p.accumulation);
     let mut slopes = Slopes::default();
     let mut stats = EvalStats::default();
@@ -309,7 +336,14 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
     };
     let (s, grad, underflow) = acc.finish();
     let reach = if SLOPE {
-        slopes.free_distance(s, acc.m, p.alpha, pruned, max_len)
+        slopes.free_distance(s, acc.m, p.alpha, pruned, along.max_len)
+    } else {
+        s
+    };
+    let reach_back = if SLOPE && s < along.back {
+        slopes
+            .reversed()
+            .free_distance(s, acc.m, p.alpha, pruned, along.back)
     } else {
         s
     };
@@ -319,6 +353,7 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
         d_seen: acc.m,
         underflow,
         reach,
+        reach_back,
         stats,
     }
 }

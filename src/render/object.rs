@@ -2,7 +2,7 @@
 //! (SPEC 2), with its evaluation parameters and the bound of where its surface can be.
 
 use crate::colour::ObjectColours;
-use crate::eval::{self, EvalParams, Sample};
+use crate::eval::{self, Along, EvalParams, Sample};
 use crate::mesh::Aabb;
 use crate::primitives::{AnySet, WeightScale};
 use glam::DVec3;
@@ -61,8 +61,8 @@ impl TraceObject {
     /// replaced (the naive mode's falloff), at opening parameter `beta` (the tracer's
     /// bound steps take a coarser one, a lower bound of the scene's sum; its hit
     /// decisions a finer one) and the pruning tolerance possibly raised (a lower bound
-    /// too, see `eval::smooth`), with the gradient if `grad`, and with the free distance
-    /// along a ray `(u, max_len)` if `along` is given (`eval::reach`); with closest-box
+    /// too, see `eval::smooth`), with the gradient if `grad`, and with the free distances
+    /// along a ray if `along` is given (`eval::reach`); with closest-box
     /// far fields if `bound` (a bound step).
     #[allow(clippy::too_many_arguments)]
     pub fn evaluate(
@@ -73,7 +73,7 @@ impl TraceObject {
         beta: f64,
         prune_tolerance: f64,
         grad: bool,
-        along: Option<(DVec3, f64)>,
+        along: Option<Along>,
         bound: bool,
     ) -> Sample {
         let mut p = self.params;

@@ -15,7 +15,12 @@ pub(super) enum Kind {
 /// ball of radius `s` around it, so the ray is free of the surface on `[t, t + s]`; a
 /// step longer than `s`, to `t + L`, is kept only if the next sample's ball reaches back
 /// over the gap: `s + s_next >= L`. Otherwise the ray returns to `t + s` (the plain step)
-/// and goes on from there: every accepted step is as safe as a plain one.
+/// and goes on from there: every accepted step is as safe as a plain one. On point
+/// clouds both ends certify more than their balls: the free distance ahead of the first
+/// sample (`eval::reach`, the step it takes when longer) and the free distance behind
+/// the next one (the same bound along `-u`, asked for only when its ball falls short,
+/// [`Stepper::needed`]). Near a surface met at an angle the field grows going back along
+/// the ray, and that reach is often several times `s_next`.
 ///
 /// The length is chosen from the slope `k` of the field along the ray, estimated from
 /// the last two samples: if the field keeps it, `s_next = s - k L`, and the largest `L`
@@ -48,16 +53,27 @@ impl Stepper {
         }
     }
 
-    /// If the last step was relaxed and the sample at `t` (lower bound `s`) does not
-    /// close the gap, the plain step's end to go back to (the slope is forgotten).
+    /// How far behind `t` the sample there must certify the ray free for the last step
+    /// to stand: the gap the last step left past its sample's certified distance (0 when
+    /// the step was not relaxed).
+    pub(super) fn needed(&self, prev: Option<(f64, f64, f64)>, t: f64) -> f64 {
+        match prev {
+            Some((tp, _, sp)) if self.relaxed => t - tp - sp,
+            _ => 0.0,
+        }
+    }
+
+    /// If the last step was relaxed and the sample at `t` (free distance `back >= 0`
+    /// behind it: its lower bound `s`, or more on point clouds) does not close the gap,
+    /// the plain step's end to go back to (the slope is forgotten).
     pub(super) fn uncovered(
         &mut self,
         prev: Option<(f64, f64, f64)>,
         t: f64,
-        s: f64,
+        back: f64,
     ) -> Option<f64> {
         let (tp, _, sp) = prev?;
-        if !self.relaxed || sp + s >= t - tp {
+        if !self.relaxed || sp + back >= t - tp {
             return None;
         }
         self.relaxed = false;

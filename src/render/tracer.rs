@@ -43,7 +43,8 @@
 //!    halves the value (0.3-0.6 per step on logged lidar rays); a slope of 1 would
 //!    predict a hit, and pay for a fine evaluation, after every first full step.
 //! 8. Steps are over-relaxed (`render::stepper`): up to `2 s / (1 + k)` for a slope `k` of the
-//!    field along the ray, kept only when the next sample's ball closes the gap, else
+//!    field along the ray, kept only when the next sample's ball closes the gap (on point
+//!    clouds, its free distance behind it, asked for only then: `eval::reach`), else
 //!    the ray returns to the plain step. Same surface, fewer steps at grazing incidence.
 //! 9. Hits are decided at a finer beta (`TracerOptions::hit_beta_scale` times the
 //!    scene's, 0.6 by default): the Barnes-Hut sum is a lower bound of the exact one,
@@ -65,7 +66,7 @@
 use super::neighbours::Neighbours;
 use super::object::TraceObject;
 use super::stepper::{Kind, Stepper};
-use crate::eval::EvalStats;
+use crate::eval::{Along, EvalStats};
 use crate::primitives::AnySet;
 use glam::DVec3;
 
@@ -104,6 +105,10 @@ pub struct TracerOptions {
     /// Steps by the free distance along the ray from the terms' slopes (`eval::reach`;
     /// objects of points only), at least the plain step.
     pub reach_steps: bool,
+    /// Over-relaxed steps on point clouds may also be certified by the free distance
+    /// behind the next sample (`render::stepper`; needs `reach_steps`), not only by its
+    /// ball.
+    pub reach_behind: bool,
     /// Clip rays to the grown scene box (misses outside it cost no evaluation). Off,
     /// rays start at the camera's smooth distance and march to the box's far side, as
     /// in the paper's renderer.
@@ -135,6 +140,7 @@ impl TracerOptions {
             hit_beta_scale: 0.6,
             step_beta: 1.0,
             reach_steps: true,
+            reach_behind: true,
             clip: true,
             backtrack: Backtrack::Illinois,
         }
@@ -152,6 +158,7 @@ impl TracerOptions {
             hit_beta_scale: 1.0,
             step_beta: 0.0,
             reach_steps: false,
+            reach_behind: false,
             clip: false,
             backtrack: Backtrack::FixedStep,
             ..TracerOptions::new(epsilon, max_steps)
@@ -214,6 +221,8 @@ struct FieldSample {
     grad: Option<DVec3>,
     /// Free distance along the ray (`eval::reach`; `s` when not asked for).
     reach: f64,
+    /// Free distance back along the ray (`s` when not asked for, or not shorter).
+    reach_back: f64,
 }
 
 /// What an evaluation is for: a bound step at a coarser beta, or a full-accuracy value
@@ -374,13 +383,14 @@ impl<'a> Tracer<'a> {
         stats: &mut RayStats,
         want: Want,
         accurate: bool,
-        along: Option<(DVec3, f64)>,
+        along: Option<Along>,
     ) -> FieldSample {
         let mut best = FieldSample {
             s: f64::INFINITY,
             object: 0,
             grad: None,
             reach: f64::INFINITY,
+            reach_back: f64::INFINITY,
         };
         // With several objects a step is the smallest value (no free distance).
         let along = along.filter(|_| self.objects.len() == 1 && !matches!(want, Want::Bound(_)));
@@ -435,6 +445,11 @@ impl<'a> Tracer<'a> {
                     grad: (grad && alpha == obj.params.alpha).then_some(sample.grad),
                     reach: if alpha == obj.params.alpha {
                         sample.reach.max(sample.s)
+                    } else {
+                        sample.s
+                    },
+                    reach_back: if alpha == obj.params.alpha {
+                        sample.reach_back.max(sample.s)
                     } else {
                         sample.s
                     },
@@ -567,12 +582,20 @@ impl<'a> Tracer<'a> {
             // An evaluation predicted to hit is made at the hit beta.
             let fine = accurate || (refine && want == Want::Gradient);
             accurate |= fine && self.sticky;
-            let along = self.options.reach_steps.then_some((d, t_max - t));
+            let along = self.options.reach_steps.then_some(Along {
+                u: d,
+                max_len: t_max - t,
+                back: if self.options.reach_behind {
+                    stepper.needed(prev, t)
+                } else {
+                    0.0
+                },
+            });
             let mut f = self.sample(x, &mut stats, want, fine, along);
             if let Some(c) = coarse_at.take() {
                 gap = (f.s - c).max(0.0);
             }
-            if let Some(back) = stepper.uncovered(prev, t, f.s) {
+            if let Some(back) = stepper.uncovered(prev, t, f.reach_back) {
                 // An over-relaxed step left a gap: go back to the plain step's end.
                 stats.rejected_steps += 1;
                 t = back;
