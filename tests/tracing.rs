@@ -87,6 +87,20 @@ fn same_surface(
     (on, plain)
 }
 
+/// Asserts that a shortcut does what it is for: fewer of `what` with it (`on`) than
+/// without it (`off`).
+fn fewer(name: &str, what: &str, on: u64, off: u64) {
+    assert!(
+        on < off,
+        "{name}: {on} {what} with the shortcut, {off} without"
+    );
+}
+
+/// Full evaluations and bound steps of a render, together.
+fn all(r: &Rendered) -> u64 {
+    r.stats.evals + r.stats.coarse_evals
+}
+
 #[test]
 fn cone_marching_finds_the_surface_every_ray_finds() {
     for name in THIN {
@@ -94,11 +108,11 @@ fn cone_marching_finds_the_surface_every_ray_finds() {
         assert!(cone.stats.tile_evals > 0, "{name}: no tile was marched");
         assert_eq!(plain.stats.tile_evals, 0);
         // The point of it: fewer bound evaluations per ray in all.
-        assert!(
-            cone.stats.coarse_evals < plain.stats.coarse_evals,
-            "{name}: cone {} vs plain {} bound evaluations",
+        fewer(
+            name,
+            "bound evaluations",
             cone.stats.coarse_evals,
-            plain.stats.coarse_evals
+            plain.stats.coarse_evals,
         );
     }
 }
@@ -111,13 +125,7 @@ fn neighbours_balls_find_the_surface_every_ray_finds() {
             ..o
         });
         // The point of it: fewer evaluations per ray in all.
-        let all = |r: &Rendered| r.stats.evals + r.stats.coarse_evals;
-        assert!(
-            all(&shared) < all(&own),
-            "{name}: with the neighbours' balls {} vs without {} evaluations",
-            all(&shared),
-            all(&own)
-        );
+        fewer(name, "evaluations", all(&shared), all(&own));
     }
 }
 
@@ -125,13 +133,7 @@ fn neighbours_balls_find_the_surface_every_ray_finds() {
 fn relaxed_steps_find_the_surface_plain_steps_find() {
     for name in THIN {
         let (relaxed, plain) = same_surface(name, |o| TracerOptions { relax: false, ..o });
-        let all = |r: &Rendered| r.stats.evals + r.stats.coarse_evals;
-        assert!(
-            all(&relaxed) < all(&plain),
-            "{name}: relaxed {} vs plain {} evaluations",
-            all(&relaxed),
-            all(&plain)
-        );
+        fewer(name, "evaluations", all(&relaxed), all(&plain));
     }
 }
 
@@ -164,11 +166,11 @@ fn relaxed_steps_certified_from_behind_find_the_surface_on_point_clouds() {
             "{name}: rejected steps {} -> {}",
             ball.stats.rejected_steps, behind.stats.rejected_steps
         );
-        assert!(
-            behind.stats.rejected_steps < ball.stats.rejected_steps,
-            "{name}: {} rejected steps certified from behind, {} by the ball alone",
+        fewer(
+            name,
+            "rejected steps",
             behind.stats.rejected_steps,
-            ball.stats.rejected_steps
+            ball.stats.rejected_steps,
         );
     }
 }

@@ -215,13 +215,13 @@ pub(crate) fn bennett_g_chord(z: f64) -> f64 {
 
 /// Evaluates the smooth distance of the union of `sets` at `x`, with its gradient.
 pub fn evaluate(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
-    evaluate_impl::<true, false>(sets, x, Along::ahead(DVec3::ZERO, 0.0), p)
+    evaluate_impl::<true, false>(sets, x, Along::NONE, p)
 }
 
 /// Evaluates the smooth distance only (the returned gradient is zero): what a sphere
 /// tracer needs for its steps, at about half the cost.
 pub fn evaluate_value(sets: &[&AnySet], x: DVec3, p: &EvalParams) -> Sample {
-    evaluate_impl::<false, false>(sets, x, Along::ahead(DVec3::ZERO, 0.0), p)
+    evaluate_impl::<false, false>(sets, x, Along::NONE, p)
 }
 
 /// A ray through the evaluation point, for free distances along it (`eval::reach`).
@@ -237,6 +237,13 @@ pub struct Along {
 }
 
 impl Along {
+    /// No free distance wanted either way.
+    pub const NONE: Along = Along {
+        u: DVec3::ZERO,
+        max_len: 0.0,
+        back: 0.0,
+    };
+
     /// Ahead only, up to `max_len`.
     pub fn ahead(u: DVec3, max_len: f64) -> Along {
         Along {
@@ -273,12 +280,11 @@ pub fn evaluate_along(
 ) -> Sample {
     let points = sets.iter().all(|s| matches!(s, AnySet::Points(_)));
     let slope = points && p.accumulation == Accumulation::Stable;
-    let none = Along::ahead(DVec3::ZERO, 0.0);
     match (along.filter(|_| slope), grad) {
         (Some(a), true) => evaluate_impl::<true, true>(sets, x, a, p),
         (Some(a), false) => evaluate_impl::<false, true>(sets, x, a, p),
-        (None, true) => evaluate_impl::<true, false>(sets, x, none, p),
-        (None, false) => evaluate_impl::<false, false>(sets, x, none, p),
+        (None, true) => evaluate_impl::<true, false>(sets, x, Along::NONE, p),
+        (None, false) => evaluate_impl::<false, false>(sets, x, Along::NONE, p),
     }
 }
 

@@ -73,7 +73,7 @@ impl Stepper {
         back: f64,
     ) -> Option<f64> {
         let (tp, _, sp) = prev?;
-        if !self.relaxed || sp + back >= t - tp {
+        if !self.relaxed || back >= self.needed(prev, t) {
             return None;
         }
         self.relaxed = false;

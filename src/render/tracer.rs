@@ -438,21 +438,22 @@ impl<'a> Tracer<'a> {
                 sample = evaluate(alpha, stats);
             }
             if sample.s < best.s {
+                // A falloff's gradient and free distances are those of a smaller alpha:
+                // the gradient is recomputed at the hit, the steps are plain.
+                let own_alpha = alpha == obj.params.alpha;
+                let free = |len: f64| {
+                    if own_alpha {
+                        len.max(sample.s)
+                    } else {
+                        sample.s
+                    }
+                };
                 best = FieldSample {
                     s: sample.s,
                     object: k,
-                    // A falloff's gradient is that of a smaller alpha: recomputed at the hit.
-                    grad: (grad && alpha == obj.params.alpha).then_some(sample.grad),
-                    reach: if alpha == obj.params.alpha {
-                        sample.reach.max(sample.s)
-                    } else {
-                        sample.s
-                    },
-                    reach_back: if alpha == obj.params.alpha {
-                        sample.reach_back.max(sample.s)
-                    } else {
-                        sample.s
-                    },
+                    grad: (grad && own_alpha).then_some(sample.grad),
+                    reach: free(sample.reach),
+                    reach_back: free(sample.reach_back),
                 };
             }
         }
