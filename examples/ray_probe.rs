@@ -8,8 +8,12 @@
 //! step length over `s` before hits from the quadratic bound, Bennett's inequality,
 //! `eval::reach` and the exact per-term bound, against the distance left to the hit),
 //! `cost` (microseconds per evaluation: value, value with free distance, gradient; at
-//! points far apart, and at the same point again, whose data the caches then hold).
+//! points far apart, and at the same point again, whose data the caches then hold),
+//! `hitcheck` (every pixel's ray traced on its own; the exact value, beta 0, at each hit
+//! point in epsilons: how far the hits sit from the exact zero set, and the share
+//! outside the hit band).
 use glam::DVec3;
+use rayon::prelude::*;
 use smoothtrace::eval::evaluate_value;
 use smoothtrace::render::build::build_scene;
 use smoothtrace::render::tracer::{RayStats, Tracer, TracerOptions};
@@ -61,6 +65,43 @@ fn main() {
                 println!("  s_BH/s_exact around the hit, steps of eps/2 (in eps): {line}");
             }
         }
+        return;
+    }
+    if args.get(4).map(String::as_str) == Some("hitcheck") {
+        let mut p = obj.params;
+        p.beta = 0.0;
+        let mut v: Vec<f64> = (0..h)
+            .into_par_iter()
+            .flat_map_iter(|py| {
+                let (tracer, sets, p) = (&tracer, &sets, &p);
+                (0..w)
+                    .filter_map(move |px| {
+                        let (o, d) = cam.ray(px, py);
+                        let hit = tracer.trace(o, d, 0.0).hit?;
+                        Some(evaluate_value(sets, hit.point, p).s / eps)
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        v.sort_by(f64::total_cmp);
+        if v.is_empty() {
+            println!("no ray hits");
+            return;
+        }
+        let q = |f: f64| v[((v.len() - 1) as f64 * f) as usize];
+        let outside = v.iter().filter(|x| x.abs() > 1.0).count();
+        println!(
+            "hits {}: exact value at the hit points (epsilons) mean {:.3}, p1 {:.3}, median {:.3}, p99 {:.3}, p99.9 {:.3}, max {:.3}; outside the band {} ({:.2}%)",
+            v.len(),
+            v.iter().sum::<f64>() / v.len().max(1) as f64,
+            q(0.01),
+            q(0.5),
+            q(0.99),
+            q(0.999),
+            v[v.len() - 1],
+            outside,
+            100.0 * outside as f64 / v.len().max(1) as f64
+        );
         return;
     }
     if args.get(4).map(String::as_str) == Some("histogram") {

@@ -12,8 +12,9 @@
 //! - prune against a budget: a subtree of `n` primitives at distance `r` that would be
 //!   opened (not a far field) holds at most `b = n w_max exp(-alpha (r - m))` (shifted);
 //!   it is skipped when `b` fits in what is left of the budget `tol S - P`, and `P`, the
-//!   pruned mass so far, grows by `b` (rounded up to a power of two: the test and the
-//!   charge cost no logarithm or exponential). `P` is shifted with `S` when `m` moves
+//!   pruned mass so far, grows by `b` rounded up to a power of `2^(1/8)` (at most 9%
+//!   above `b`; the test and the charge look mantissas up in tables of eight steps per
+//!   octave and cost no logarithm or exponential, `eval::walk`). `P` is shifted with `S` when `m` moves
 //!   and added to the sum at the end, so it stays below `tol` of the final sum. The
 //!   union bound of the first rule charges each subtree for all `N` primitives; the
 //!   budget charges what was actually skipped, so it skips whole subtrees much nearer

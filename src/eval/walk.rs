@@ -124,6 +124,70 @@ fn exponent(v: f64) -> i64 {
     ((v.to_bits() >> 52) & 0x7ff) as i64 - 1023
 }
 
+/// Steps of the budget's charges per octave: a charge is the subtree's bound rounded up
+/// to a power of `2^(1/STEPS)` (at most 9% above it). Charges rounded up to a power of 2
+/// (up to twice the bound, and the test up to four times stricter) spent the budget on
+/// fewer subtrees: the lidar at 1920x1080 visits 8% fewer leaves with eighths.
+const STEPS: usize = 8;
+
+/// `log2(1 + i / STEPS)`, `i = 0 .. STEPS` (the last is 1), to the nearest double
+/// (`log2_down` and `log2_up` move off it by more than its rounding).
+const LOG2_STEP: [f64; STEPS + 1] = [
+    0.0,
+    0.16992500144231237,
+    0.32192809488736235,
+    0.45943161863729726,
+    0.5849625007211562,
+    0.7004397181410922,
+    0.8073549220576041,
+    0.9068905956085185,
+    1.0,
+];
+
+/// `2^(-i / STEPS)`, `i = 0 .. STEPS`, to the nearest double (the charge's last factor
+/// covers its rounding).
+const EXP2_NEG_STEP: [f64; STEPS] = [
+    1.0,
+    0.9170040432046712,
+    0.8408964152537145,
+    0.7711054127039704,
+    std::f64::consts::FRAC_1_SQRT_2,
+    0.6484197773255048,
+    0.5946035575013605,
+    0.5452538663326288,
+];
+
+/// The mantissa's place among the `STEPS` steps of its octave, `floor(STEPS (f - 1))`
+/// for `v = 2^e f`, `f` in `[1, 2)` (positive normal `v`).
+#[inline(always)]
+fn step_of(v: f64) -> usize {
+    ((v.to_bits() >> (52 - STEPS.trailing_zeros())) as usize) & (STEPS - 1)
+}
+
+/// A lower bound of `log2 v` (within `log2(1 + 1/STEPS)`), positive normal `v`.
+#[inline(always)]
+fn log2_down(v: f64) -> f64 {
+    exponent(v) as f64 + LOG2_STEP[step_of(v)] - 1e-15
+}
+
+/// An upper bound of `log2 v` (within `log2(1 + 1/STEPS)`), positive normal `v`.
+#[inline(always)]
+fn log2_up(v: f64) -> f64 {
+    exponent(v) as f64 + LOG2_STEP[step_of(v) + 1] + 1e-15
+}
+
+/// `nw exp(-alpha dr)` (`dr >= 0`, `alpha_log2e = alpha log2 e`) rounded up to the next
+/// power of `2^(1/STEPS)` times `nw`: `nw 2^(-j / STEPS)` with `j = floor(STEPS alpha dr
+/// log2 e)`, the product shortened by 1e-12 so that rounding cannot carry `j` over a
+/// step, and the last factor covering the products' rounding.
+#[inline(always)]
+fn step_charge(nw: f64, alpha_log2e: f64, dr: f64) -> f64 {
+    let j = (dr * (STEPS as f64 * alpha_log2e) * (1.0 - 1e-12)) as i64;
+    nw * pow2(-(j / STEPS as i64))
+        * EXP2_NEG_STEP[(j % STEPS as i64) as usize]
+        * (1.0 + 4.0 * f64::EPSILON)
+}
+
 /// `2^e` for `e <= 1023` (0 below the normal range, where the charge is negligible).
 #[inline(always)]
 fn pow2(e: i64) -> f64 {
@@ -200,10 +264,13 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
     }
 
     /// Prunes a subtree of `n` primitives at squared distance `r2` if its bound
-    /// `n w exp(-alpha (r - m))` fits in what is left of the budget `tol S - P`: with
-    /// `2^e_nw >= n w` and `2^e_left <= tol S - P`, it fits once `alpha (r - m) >= k ln 2`
-    /// for `k = e_nw - e_left`, and `P` grows by `2^(e_nw - j)`, `j = floor(alpha (r - m)
-    /// log2 e) >= k`, an upper bound of the subtree's mass that stays within the budget.
+    /// `b = n w exp(-alpha (r - m))` fits in what is left of the budget `tol S - P`.
+    /// `b <= left` needs `alpha (r - m) >= ln(n w / left)`, tested first with bounds of
+    /// both logarithms (mantissas looked up in `STEPS` steps per octave, no logarithm
+    /// computed); then `P` grows by the charge `n w 2^(-j / STEPS)`, `j = floor(STEPS
+    /// alpha (r - m) log2 e)`, which is `b` rounded up to the next step (at most 9%
+    /// above it; the last factor covers the products' rounding) and is charged only if
+    /// it still fits.
     #[inline(always)]
     fn budget_prune(&mut self, r2: f64, n: u32) -> bool {
         let left = self.budget_left();
@@ -211,15 +278,17 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             return false;
         }
         let acc = &mut *self.sink.acc;
-        let e_left = exponent(left);
-        let e_nw = exponent(n as f64 * self.w_ff) + 1;
-        let k = (e_nw - e_left).max(0);
-        let need = acc.m + k as f64 * self.ln2_over_alpha;
+        let nw = n as f64 * self.w_ff;
+        let k = (log2_up(nw) - log2_down(left)).max(0.0);
+        let need = acc.m + k * self.ln2_over_alpha;
         if r2 < need * need {
             return false;
         }
-        let j = ((r2.sqrt() - acc.m) * self.alpha_log2e) as i64;
-        acc.pruned += pow2(e_nw - j.max(k));
+        let charge = step_charge(nw, self.alpha_log2e, r2.sqrt() - acc.m);
+        if charge > left {
+            return false;
+        }
+        acc.pruned += charge;
         self.stats.pruned += 1;
         true
     }
@@ -416,5 +485,65 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             return;
         }
         open.insert(d2k, k);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Values over the whole normal range, and every step of an octave.
+    fn samples() -> impl Iterator<Item = f64> {
+        let mut seed = 11u64;
+        (0..20_000).map(move |k| {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            let f = 1.0 + (seed >> 11) as f64 / (1u64 << 53) as f64;
+            f * 2f64.powi((k % 2000) - 1000)
+        })
+    }
+
+    #[test]
+    fn stepped_logarithms_bracket_log2_within_a_step() {
+        let step = (1.0 + 1.0 / STEPS as f64).log2();
+        for v in samples().chain((0..=STEPS).map(|i| 1.0 + i as f64 / STEPS as f64)) {
+            let (lo, hi, l) = (log2_down(v), log2_up(v), v.log2());
+            assert!(lo <= l && l <= hi, "{v}: {lo} {l} {hi}");
+            assert!(hi - lo <= step + 1e-12, "{v}: {lo} {hi}");
+        }
+    }
+
+    #[test]
+    fn stepped_charges_bound_the_subtree_within_a_step() {
+        let step = 2f64.powf(1.0 / STEPS as f64);
+        let mut seed = 5u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..100_000 {
+            let nw = (1.0 + 1e6 * rnd()).floor() * (0.5 + rnd());
+            let alpha = 10f64.powf(4.0 * rnd() - 2.0);
+            let dr = 600.0 * rnd() / alpha;
+            let b = nw * (-alpha * dr).exp();
+            let c = step_charge(nw, alpha * std::f64::consts::LOG2_E, dr);
+            assert!(
+                c >= b,
+                "charge {c} below the bound {b} (nw {nw}, alpha dr {})",
+                alpha * dr
+            );
+            assert!(
+                c <= b * step * (1.0 + 1e-9),
+                "charge {c} above a step over {b}"
+            );
+        }
+        // On the steps themselves (where rounding could carry `j` over one).
+        for j in 0..64 {
+            let dr = j as f64 / STEPS as f64 * std::f64::consts::LN_2;
+            let b = (-dr).exp();
+            assert!(
+                step_charge(1.0, std::f64::consts::LOG2_E, dr) >= b,
+                "step {j}"
+            );
+        }
     }
 }
