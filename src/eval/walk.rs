@@ -125,9 +125,9 @@ fn exponent(v: f64) -> i64 {
 }
 
 /// Steps of the budget's charges per octave: a charge is the subtree's bound rounded up
-/// to a power of `2^(1/STEPS)` (at most 9% above it). Charges rounded up to a power of 2
-/// (up to twice the bound, and the test up to four times stricter) spent the budget on
-/// fewer subtrees: the lidar at 1920x1080 visits 8% fewer leaves with eighths.
+/// to a power of `2^(1/STEPS)` (at most 9% above it). Charges rounded up to powers of 2
+/// (up to four times the bound, the test as much stricter) spent the budget on fewer
+/// subtrees: the lidar at 1920x1080 visits 8% fewer leaves with eighths.
 const STEPS: usize = 8;
 
 /// `log2(1 + i / STEPS)`, `i = 0 .. STEPS` (the last is 1), to the nearest double
