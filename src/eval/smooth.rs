@@ -30,8 +30,8 @@
 //!   Together (`tol1 + tol2 <= 2 tol`), `s` stays a lower bound of the exact value and
 //!   within `2 tol / alpha` of it. The nearest primitive is never pruned by the first
 //!   rule, so `s <= d_min` holds exactly (and always holds: `s` is below the exact
-//!   smooth distance). This is what makes beta = 0 cheap at large alpha. `EvalParams::prune = false` turns both
-//!   off (the paper's traversal).
+//!   smooth distance). This is what makes beta = 0 cheap at large alpha.
+//!   `EvalParams::prune = false` turns both off (the paper's traversal).
 //! - far field: if the node is not a leaf and `diam(B) < beta r`, add one term
 //!   `n w_ff exp(-alpha r)` with direction `(x - c) / r` and `w_ff = max_adj^q`. Every
 //!   primitive below is at least `r` away with weight at most `w_ff`, so the far term
