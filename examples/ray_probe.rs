@@ -17,6 +17,7 @@ use rayon::prelude::*;
 use smoothtrace::eval::evaluate_value;
 use smoothtrace::render::build::build_scene;
 use smoothtrace::render::tracer::{RayStats, Tracer, TracerOptions};
+use smoothtrace::reports::quantile;
 use smoothtrace::scene::Scene;
 use std::path::Path;
 
@@ -83,24 +84,19 @@ fn main() {
                     .collect::<Vec<_>>()
             })
             .collect();
-        v.sort_by(f64::total_cmp);
         if v.is_empty() {
             println!("no ray hits");
             return;
         }
-        let q = |f: f64| v[((v.len() - 1) as f64 * f) as usize];
+        let mut q = |f: f64| quantile(&mut v, f).unwrap_or(f64::NAN);
+        let (p1, p50, p99, p999, max) = (q(0.01), q(0.5), q(0.99), q(0.999), q(1.0));
         let outside = v.iter().filter(|x| x.abs() > 1.0).count();
         println!(
-            "hits {}: exact value at the hit points (epsilons) mean {:.3}, p1 {:.3}, median {:.3}, p99 {:.3}, p99.9 {:.3}, max {:.3}; outside the band {} ({:.2}%)",
+            "hits {}: exact value at the hit points (epsilons) mean {:.3}, p1 {p1:.3}, median {p50:.3}, p99 {p99:.3}, p99.9 {p999:.3}, max {max:.3}; outside the band {} ({:.2}%)",
             v.len(),
-            v.iter().sum::<f64>() / v.len().max(1) as f64,
-            q(0.01),
-            q(0.5),
-            q(0.99),
-            q(0.999),
-            v[v.len() - 1],
+            v.iter().sum::<f64>() / v.len() as f64,
             outside,
-            100.0 * outside as f64 / v.len().max(1) as f64
+            100.0 * outside as f64 / v.len() as f64
         );
         return;
     }

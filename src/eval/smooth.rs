@@ -83,7 +83,7 @@ const FIRST_RULE_SHARE: f64 = 0.25;
 
 /// The tolerances of the first pruning rule and of the budget (0: no budget), whose sum
 /// bounds the share of the sum that pruning may skip (module docs).
-pub(super) fn rule_tolerances(p: &EvalParams) -> (f64, f64) {
+fn rule_tolerances(p: &EvalParams) -> (f64, f64) {
     let tol = p.prune_tolerance;
     if p.budget && p.prune && p.accumulation == Accumulation::Stable {
         (FIRST_RULE_SHARE * tol, (2.0 - FIRST_RULE_SHARE) * tol)
@@ -333,7 +333,8 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
     let mut slopes = Slopes::default();
     let mut stats = EvalStats::default();
     let scale = |s: &AnySet| WeightScale::new(s.max_adj(), p.alpha, p.max_alpha);
-    let (first_tol, _) = rule_tolerances(p);
+    // The first rule's share of the tolerance and the budget's, once per evaluation.
+    let (first_tol, budget) = rule_tolerances(p);
     let prune_margin = if p.prune {
         prune_margin(sets, p, first_tol)
     } else {
@@ -348,7 +349,7 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
                 u,
             };
             crate::with_set!(set, s => {
-                Walk::new(s, x, p, &sc, prune_margin, &mut sink, &mut stats, stack).run()
+                Walk::new(s, x, p, &sc, prune_margin, budget, &mut sink, &mut stats, stack).run()
             });
         }
     });

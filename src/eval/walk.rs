@@ -5,7 +5,7 @@
 //! above by the caller), far field (one term `n w exp(-alpha r)`), exact (a leaf's
 //! primitives) or opened.
 
-use super::smooth::{EvalParams, EvalStats, Sink, rule_tolerances};
+use super::smooth::{EvalParams, EvalStats, Sink};
 use crate::bvh::moments::{MIDDLE, lin_bound, quadratic_form};
 use crate::bvh::wide::{EMPTY, Root};
 use crate::bvh::{Moments4, Node4};
@@ -205,6 +205,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         p: &EvalParams,
         scale: &'w WeightScale,
         prune_margin: f64,
+        budget: f64,
         sink: &'w mut Sink<'a, GRAD, SLOPE>,
         stats: &'w mut EvalStats,
         stack: &'w mut Vec<Entry>,
@@ -221,7 +222,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             beta2: if p.beta > 0.0 { p.beta * p.beta } else { -1.0 },
             w_ff: scale.max_weight(),
             moments: if p.moments { &set.bvh.moments } else { &[] },
-            budget: rule_tolerances(p).1,
+            budget,
             ln2_over_alpha: std::f64::consts::LN_2 / p.alpha,
             alpha_log2e: p.alpha * std::f64::consts::LOG2_E,
             e_w: exponent(scale.max_weight()) + 1,
