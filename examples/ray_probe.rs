@@ -15,8 +15,9 @@
 use glam::DVec3;
 use rayon::prelude::*;
 use smoothtrace::eval::evaluate_value;
+use smoothtrace::render::TracerOptions;
 use smoothtrace::render::build::build_scene;
-use smoothtrace::render::tracer::{RayStats, Tracer, TracerOptions};
+use smoothtrace::render::tracer::{RayStats, Tracer};
 use smoothtrace::reports::quantile;
 use smoothtrace::scene::Scene;
 use std::path::Path;

@@ -3,11 +3,13 @@
 pub mod cone;
 pub mod neighbours;
 pub mod object;
+pub mod options;
 mod stepper;
 pub mod tracer;
 
 pub use object::TraceObject;
-pub use tracer::{Backtrack, Hit, RayResult, RayStats, Tracer, TracerOptions};
+pub use options::{Backtrack, TracerOptions};
+pub use tracer::{Hit, RayResult, RayStats, Tracer};
 pub mod albedo;
 pub mod build;
 pub mod image;

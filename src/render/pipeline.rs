@@ -6,7 +6,8 @@
 
 use super::build::{BuildError, BuiltScene, build_scene};
 use super::image::{Rendered, render_film};
-use super::tracer::{Tracer, TracerOptions};
+use super::options::TracerOptions;
+use super::tracer::Tracer;
 use crate::camera::Camera;
 use crate::film::FilmOptions;
 use crate::scene::Scene;

@@ -1,0 +1,99 @@
+//! The sphere tracer's settings (SPEC 7): which of the tracer's devices are on and their
+//! parameters. Each field's meaning is stated where it is declared; the items cited are
+//! those of the `render::tracer` module docs.
+
+/// Tracer settings.
+#[derive(Clone, Copy, Debug)]
+pub struct TracerOptions {
+    /// Hit threshold in world units.
+    pub epsilon: f64,
+    /// Largest number of field evaluations per ray before giving up (a miss).
+    pub max_steps: u32,
+    /// Opening parameter of the cheapest bound steps, taken far from the surface (0 =
+    /// off). Any Barnes-Hut sum coarser than the scene's is a lower bound of it (a
+    /// parent's far-field term dominates everything below it), so these steps are as
+    /// safe as the scene's own; the hit itself is always decided at the scene's beta.
+    pub coarse_beta: f64,
+    /// Coarse steps are taken while the coarse value exceeds this many epsilons.
+    pub coarse_threshold: f64,
+    /// The same where every object is made of points only (their full steps are made at
+    /// `step_beta`, so a full step pays off earlier).
+    pub coarse_threshold_points: f64,
+    /// March primary-ray tiles as cones first (`cone`; needs `coarse_beta > 0`).
+    pub cone: bool,
+    /// Within a cone-marched tile, start each ray past the empty balls of the rays traced
+    /// just before it (`render::neighbours`; needs `cone`).
+    pub neighbours: bool,
+    /// Over-relaxed steps, each certified by the next sample's value (see `Stepper`).
+    pub relax: bool,
+    /// Hits on objects with edges or triangles are decided at this share of the scene's
+    /// beta (tracer module docs, item 9); 1 decides them at the scene's beta (the paper's).
+    pub hit_beta_scale: f64,
+    /// Full evaluations that only take a step (not predicted to hit) are made at this
+    /// opening parameter when it is coarser than the scene's (0 = the scene's beta):
+    /// still a lower bound, so the step is safe, at a fraction of the terms. Any value in
+    /// the hit band or below is taken again at the hit beta before it decides anything.
+    pub step_beta: f64,
+    /// Steps by the free distance along the ray from the terms' slopes (`eval::reach`;
+    /// objects of points only), at least the plain step.
+    pub reach_steps: bool,
+    /// Over-relaxed steps on point clouds may also be certified by the free distance
+    /// behind the next sample (`render::stepper`; needs `reach_steps`), not only by its
+    /// ball.
+    pub reach_behind: bool,
+    /// Clip rays to the grown scene box (misses outside it cost no evaluation). Off,
+    /// rays start at the camera's smooth distance and march to the box's far side, as
+    /// in the paper's renderer.
+    pub clip: bool,
+    pub backtrack: Backtrack,
+}
+
+/// How a step that overshoots into the negative band is resolved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backtrack {
+    /// Safeguarded regula falsi on the bracket (default).
+    Illinois,
+    /// March back in steps of epsilon until the value is above -epsilon (the paper's).
+    FixedStep,
+}
+
+impl TracerOptions {
+    /// Defaults for a hit threshold `epsilon`.
+    pub fn new(epsilon: f64, max_steps: u32) -> TracerOptions {
+        TracerOptions {
+            epsilon,
+            max_steps,
+            coarse_beta: 4.0,
+            coarse_threshold: 4.0,
+            coarse_threshold_points: 8.0,
+            cone: true,
+            neighbours: true,
+            relax: true,
+            hit_beta_scale: 0.6,
+            step_beta: 1.0,
+            reach_steps: true,
+            reach_behind: true,
+            clip: true,
+            backtrack: Backtrack::Illinois,
+        }
+    }
+
+    /// The paper's tracer: every step at the scene's beta, no ray clipping, fixed-step
+    /// backtracking. (Pair with `EvalParams::prune = false` and the naive sum for the
+    /// paper's evaluator.)
+    pub fn paper(epsilon: f64, max_steps: u32) -> TracerOptions {
+        TracerOptions {
+            coarse_beta: 0.0,
+            cone: false,
+            neighbours: false,
+            relax: false,
+            hit_beta_scale: 1.0,
+            step_beta: 0.0,
+            reach_steps: false,
+            reach_behind: false,
+            clip: false,
+            backtrack: Backtrack::FixedStep,
+            ..TracerOptions::new(epsilon, max_steps)
+        }
+    }
+}
