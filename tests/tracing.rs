@@ -69,9 +69,18 @@ fn same_surface(
     name: &str,
     off: impl Fn(TracerOptions) -> TracerOptions + Send + Sync,
 ) -> (Rendered, Rendered) {
+    same_surface_from(name, |o| o, off)
+}
+
+/// [`same_surface`] from the tracer settings `base` instead of the defaults.
+fn same_surface_from(
+    name: &str,
+    base: impl Fn(TracerOptions) -> TracerOptions + Send + Sync + Copy,
+    off: impl Fn(TracerOptions) -> TracerOptions + Send + Sync,
+) -> (Rendered, Rendered) {
     let s = scene(name, 240, 135);
-    let (eps, _, on) = render(&s, |o| o);
-    let (_, _, plain) = render(&s, off);
+    let (eps, _, on) = render(&s, base);
+    let (_, _, plain) = render(&s, |o| off(base(o)));
     // Depths in units of epsilon.
     let d = compare_depths(&on.depth, &plain.depth, 1.0, eps);
     let only_one = d.only_one_percent();
@@ -157,7 +166,13 @@ fn point_scenes() -> Vec<&'static str> {
 #[test]
 fn relaxed_steps_certified_from_behind_find_the_surface_on_point_clouds() {
     for name in point_scenes() {
-        let (behind, ball) = same_surface(name, |o| TracerOptions {
+        // At the fixed step beta, as on the lidar scan, whose tiles keep it: where the
+        // tiles learn to step at the hit beta (`render::step_beta`), few steps fail.
+        let fixed = |o| TracerOptions {
+            learn_step_beta: false,
+            ..o
+        };
+        let (behind, ball) = same_surface_from(name, fixed, |o| TracerOptions {
             reach_behind: false,
             ..o
         });
@@ -218,6 +233,76 @@ fn reach_steps_find_the_surface_plain_steps_find() {
             per_hit(&reach),
             per_hit(&stepped)
         );
+    }
+}
+
+/// A tile's step beta learned from its refinements (`render::step_beta`): as close to the
+/// exact surface as steps at the fixed step beta, and on the soft point clouds (the
+/// sphere of points, the deer at alpha 1), where the coarse step values fall several
+/// epsilons below the hit beta's and nearly every hit ray pays a refinement, with fewer
+/// of them and fewer full evaluations. The tiles of the edge and triangle scenes of
+/// `THIN` learn nothing (their gaps stay under half an epsilon) and render as before.
+#[test]
+fn learned_step_beta_finds_the_surface_the_fixed_one_finds() {
+    let fixed = |o| TracerOptions {
+        learn_step_beta: false,
+        ..o
+    };
+    for name in point_scenes() {
+        let s = scene(name, 240, 135);
+        let (eps, _, learned) = render(&s, |o| o);
+        let (_, _, steady) = render(&s, fixed);
+        let mut exact = s.clone();
+        exact.render.beta = 0.0;
+        let (_, _, exact) = render(&exact, fixed);
+        let (a, b) = (
+            compare_depths(&learned.depth, &exact.depth, 1.0, eps),
+            compare_depths(&steady.depth, &exact.depth, 1.0, eps),
+        );
+        let per_hit = |r: &Rendered| r.stats.hit_evals as f64 / r.stats.hits as f64;
+        eprintln!(
+            "{name}: vs exact, learned {a:?}\n   fixed {b:?}\n   refinements {} -> {}, \
+             full evaluations per hit ray {:.2} -> {:.2}",
+            steady.stats.refinements,
+            learned.stats.refinements,
+            per_hit(&steady),
+            per_hit(&learned)
+        );
+        assert!(
+            a.only_one <= b.only_one + learned.stats.rays as usize / 500,
+            "{name}: {} rays hit in only one of the learned and exact renders, {} fixed",
+            a.only_one,
+            b.only_one
+        );
+        assert!(
+            a.p50.unwrap() <= b.p50.unwrap() + 0.5 && a.p99.unwrap() <= b.p99.unwrap() + 1.0,
+            "{name}: depth error against the exact surface, learned {a:?} vs fixed {b:?}"
+        );
+        fewer(
+            name,
+            "refinements",
+            learned.stats.refinements,
+            steady.stats.refinements,
+        );
+        // The bunny's points learn less (gaps of 1-3 epsilons, 4.85 -> 3.84 at this size).
+        let share = if name == "bunny_points.toml" {
+            0.9
+        } else {
+            0.8
+        };
+        assert!(
+            per_hit(&learned) < share * per_hit(&steady),
+            "{name}: {:.2} vs {:.2} full evaluations per hit ray",
+            per_hit(&learned),
+            per_hit(&steady)
+        );
+    }
+    for name in THIN {
+        let s = scene(name, 160, 90);
+        let (_, _, learned) = render(&s, |o| o);
+        let (_, _, steady) = render(&s, fixed);
+        assert_eq!(learned.stats.hit_evals, steady.stats.hit_evals, "{name}");
+        assert_eq!(learned.depth, steady.depth, "{name}");
     }
 }
 

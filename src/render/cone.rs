@@ -18,6 +18,7 @@
 //! the empty balls of the tile's rays traced just before it (`render::neighbours`).
 
 use super::neighbours::Neighbours;
+use super::step_beta::StepBeta;
 use super::tracer::{RayResult, RayStats, Tracer};
 use crate::camera::Camera;
 use glam::DVec3;
@@ -87,8 +88,9 @@ pub fn trace_tile(
     stats: &mut ConeStats,
     out: &mut dyn FnMut(u32, u32, RayResult),
 ) {
+    let mut steps = StepBeta::new(tracer.options().learn_step_beta);
     if !cone || tracer.options().coarse_beta <= 0.0 {
-        return trace_rays(tracer, camera, tile, sub, t_start, None, out);
+        return trace_rays(tracer, camera, tile, sub, t_start, None, &mut steps, out);
     }
     let mut near = tracer.options().neighbours.then(Neighbours::new);
     let mut march = March {
@@ -97,13 +99,15 @@ pub fn trace_tile(
         sub,
         stats,
         near: near.as_mut(),
+        steps: &mut steps,
         out,
     };
     march.tile(tile, t_start);
 }
 
 /// Traces every pixel of `tile` ray by ray from `t_start`, each past its neighbours'
-/// balls if `near` is given.
+/// balls if `near` is given, at the tile's learned step beta (`render::step_beta`).
+#[allow(clippy::too_many_arguments)]
 fn trace_rays(
     tracer: &Tracer,
     camera: &Camera,
@@ -111,15 +115,13 @@ fn trace_rays(
     sub: [f64; 2],
     t_start: f64,
     mut near: Option<&mut Neighbours>,
+    steps: &mut StepBeta,
     out: &mut dyn FnMut(u32, u32, RayResult),
 ) {
     for py in tile.y0..tile.y0 + tile.h {
         for px in tile.x0..tile.x0 + tile.w {
             let (o, d) = ray(camera, px, py, sub);
-            let r = match near.as_deref_mut() {
-                Some(n) => tracer.trace_near(o, d, t_start, n),
-                None => tracer.trace(o, d, t_start),
-            };
+            let r = tracer.trace_in_tile(o, d, t_start, near.as_deref_mut(), steps);
             out(px, py, r);
         }
     }
@@ -138,6 +140,8 @@ struct March<'m, 't> {
     stats: &'m mut ConeStats,
     /// The balls of the tile's last rays (`render::neighbours`), if used.
     near: Option<&'m mut Neighbours>,
+    /// The tile's learned step beta (`render::step_beta`).
+    steps: &'m mut StepBeta,
     out: &'m mut dyn FnMut(u32, u32, RayResult),
 }
 
@@ -215,6 +219,7 @@ impl March<'_, '_> {
             self.sub,
             t_start,
             near,
+            self.steps,
             self.out,
         );
     }

@@ -4,6 +4,7 @@ pub mod cone;
 pub mod neighbours;
 pub mod object;
 pub mod options;
+pub mod step_beta;
 mod stepper;
 pub mod tracer;
 

@@ -34,6 +34,9 @@ pub struct TracerOptions {
     /// still a lower bound, so the step is safe, at a fraction of the terms. Any value in
     /// the hit band or below is taken again at the hit beta before it decides anything.
     pub step_beta: f64,
+    /// The step beta of a tile's later rays moves towards the hit beta where its rays'
+    /// refinements find the step values several epsilons low (`render::step_beta`).
+    pub learn_step_beta: bool,
     /// Steps by the free distance along the ray from the terms' slopes (`eval::reach`;
     /// objects of points only), at least the plain step.
     pub reach_steps: bool,
@@ -71,6 +74,7 @@ impl TracerOptions {
             relax: true,
             hit_beta_scale: 0.6,
             step_beta: 1.0,
+            learn_step_beta: true,
             reach_steps: true,
             reach_behind: true,
             clip: true,
@@ -89,6 +93,7 @@ impl TracerOptions {
             relax: false,
             hit_beta_scale: 1.0,
             step_beta: 0.0,
+            learn_step_beta: false,
             reach_steps: false,
             reach_behind: false,
             clip: false,

@@ -62,10 +62,14 @@
 //!     are made at the coarser `TracerOptions::step_beta` (1 by default): a lower bound
 //!     too, so the step is safe, at 60-75% of the terms near the surface; a value in
 //!     the hit band or below is taken again at the hit beta before it decides anything.
+//!     Where those refinements find the step values several epsilons low (soft point
+//!     clouds), the tile's later rays step at a beta closer to the hit beta
+//!     (`render::step_beta`).
 
 use super::neighbours::Neighbours;
 use super::object::TraceObject;
 use super::options::{Backtrack, TracerOptions};
+use super::step_beta::StepBeta;
 use super::stepper::{Kind, Stepper};
 use crate::eval::{Along, EvalStats};
 use crate::primitives::AnySet;
@@ -244,7 +248,7 @@ impl<'a> Tracer<'a> {
 
     /// The scene field at `x` (the minimum over objects) and the object attaining it.
     pub fn field(&self, x: DVec3, stats: &mut RayStats) -> (f64, usize) {
-        let f = self.sample(x, stats, Want::Value, false, None);
+        let f = self.sample(x, stats, Want::Value, false, None, StepBeta::default());
         (f.s, f.object)
     }
 
@@ -252,7 +256,15 @@ impl<'a> Tracer<'a> {
     /// parameter `beta` (at least the scene's): cheaper than [`Tracer::field`] for a
     /// larger `beta`, counted as a bound step.
     pub fn bound(&self, x: DVec3, beta: f64, stats: &mut RayStats) -> f64 {
-        self.sample(x, stats, Want::Bound(beta), false, None).s
+        self.sample(
+            x,
+            stats,
+            Want::Bound(beta),
+            false,
+            None,
+            StepBeta::default(),
+        )
+        .s
     }
 
     /// The gradient of object `k`'s smooth distance at `x` (one evaluation, at the hit
@@ -289,6 +301,7 @@ impl<'a> Tracer<'a> {
         want: Want,
         accurate: bool,
         along: Option<Along>,
+        step_beta: StepBeta,
     ) -> FieldSample {
         let mut best = FieldSample {
             s: f64::INFINITY,
@@ -313,7 +326,7 @@ impl<'a> Tracer<'a> {
                 let beta = match coarse {
                     Some(b) => b.max(obj.params.beta),
                     None if accurate => self.hit_beta[k],
-                    None => self.step_beta[k],
+                    None => step_beta.beta(self.step_beta[k], self.hit_beta[k]),
                 };
                 let sample = obj.evaluate(
                     &self.sets[k],
@@ -384,15 +397,26 @@ impl<'a> Tracer<'a> {
 
     /// Traces the ray from `o` along unit `d`, starting no earlier than `t_start`.
     pub fn trace(&self, o: DVec3, d: DVec3, t_start: f64) -> RayResult {
-        self.trace_impl(o, d, t_start, None)
+        self.trace_impl(o, d, t_start, None, None)
     }
 
     /// [`Tracer::trace`] for a ray of a tile: it starts past the stretch that the empty
     /// balls of the tile's last rays certify, and leaves its own balls for the next
-    /// (`render::neighbours`).
-    pub fn trace_near(&self, o: DVec3, d: DVec3, t_start: f64, near: &mut Neighbours) -> RayResult {
-        let r = self.trace_impl(o, d, t_start, Some(&mut *near));
-        near.finish_ray();
+    /// (`render::neighbours`), if `near` is given; its step evaluations are made at the
+    /// tile's learned step beta, and its refinement, if any, teaches the tile
+    /// (`render::step_beta`).
+    pub fn trace_in_tile(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        t_start: f64,
+        mut near: Option<&mut Neighbours>,
+        steps: &mut StepBeta,
+    ) -> RayResult {
+        let r = self.trace_impl(o, d, t_start, near.as_deref_mut(), Some(steps));
+        if let Some(n) = near {
+            n.finish_ray();
+        }
         r
     }
 
@@ -402,6 +426,7 @@ impl<'a> Tracer<'a> {
         d: DVec3,
         t_start: f64,
         mut balls: Option<&mut Neighbours>,
+        mut steps: Option<&mut StepBeta>,
     ) -> RayResult {
         let mut stats = RayStats::default();
         let eps = self.options.epsilon;
@@ -440,7 +465,9 @@ impl<'a> Tracer<'a> {
         let mut want = Want::Value;
         // Once set, every full evaluation of the ray is accurate (module docs, item 9).
         let mut accurate = false;
-        let refine = self.refine;
+        // The tile's step beta (`render::step_beta`): at the hit beta, no refinement.
+        let step_beta = steps.as_deref().copied().unwrap_or_default();
+        let refine = self.refine && step_beta.share() < 1.0;
         while t <= t_max {
             if stats.evals + stats.coarse_evals >= self.options.max_steps {
                 stats.exhausted = true;
@@ -448,7 +475,14 @@ impl<'a> Tracer<'a> {
             }
             let x = o + t * d;
             if let (Some(beta), false) = (coarse, near) {
-                let c = self.sample(x, &mut stats, Want::Bound(beta), false, None);
+                let c = self.sample(
+                    x,
+                    &mut stats,
+                    Want::Bound(beta),
+                    false,
+                    None,
+                    StepBeta::default(),
+                );
                 if c.s > eps {
                     if let Some(n) = balls.as_deref_mut() {
                         n.note(x, c.s);
@@ -497,7 +531,7 @@ impl<'a> Tracer<'a> {
                     0.0
                 },
             });
-            let mut f = self.sample(x, &mut stats, want, fine, along);
+            let mut f = self.sample(x, &mut stats, want, fine, along, step_beta);
             if let Some(c) = coarse_at.take() {
                 gap = (f.s - c).max(0.0);
             }
@@ -513,7 +547,11 @@ impl<'a> Tracer<'a> {
                 // (a lower bound too, so the step that got here stays safe).
                 accurate = true;
                 stats.refinements += 1;
-                f = self.sample(x, &mut stats, Want::Gradient, true, along);
+                let coarse = f.s;
+                f = self.sample(x, &mut stats, Want::Gradient, true, along, step_beta);
+                if let Some(st) = steps.as_deref_mut() {
+                    st.refined(coarse, f.s, eps);
+                }
             }
             near = f.s - gap < 2.0 * tau;
             if f.s.abs() <= eps {
@@ -581,7 +619,14 @@ impl<'a> Tracer<'a> {
         while stats.evals + stats.coarse_evals < self.options.max_steps {
             t -= eps;
             let before = stats.evals;
-            let f = self.sample(o + t * d, stats, Want::Value, true, None);
+            let f = self.sample(
+                o + t * d,
+                stats,
+                Want::Value,
+                true,
+                None,
+                StepBeta::default(),
+            );
             stats.backtracks += stats.evals - before;
             if f.s >= -eps {
                 return Some(self.hit(o, d, t, &f, stats));
@@ -613,7 +658,14 @@ impl<'a> Tracer<'a> {
                 t = 0.5 * (lo + hi);
             }
             let before = stats.evals;
-            let f = self.sample(o + t * d, stats, Want::Value, true, None);
+            let f = self.sample(
+                o + t * d,
+                stats,
+                Want::Value,
+                true,
+                None,
+                StepBeta::default(),
+            );
             stats.backtracks += stats.evals - before;
             if f.s.abs() <= eps || hi - lo <= eps {
                 return Some(self.hit(o, d, t, &f, stats));
