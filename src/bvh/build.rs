@@ -118,6 +118,27 @@ pub fn build_binary_points(points: &[Vec3], options: BuildOptions) -> Bvh {
     build_with(points.len(), |i| points[i], None, options)
 }
 
+/// [`build_binary_points`] that also makes the points' primitives in leaf order
+/// (`make(points[order[i]])` at `i`), from the build's records, which hold the points in
+/// that order: no gather from `points`.
+pub fn build_binary_points_with<P: Send>(
+    points: &[Vec3],
+    options: BuildOptions,
+    make: impl Fn(Vec3) -> P + Sync + Send,
+) -> (Bvh, Vec<P>) {
+    let (nodes, items) = build_records(points.len(), |i| points[i], None, options);
+    let (order, sorted) = items
+        .par_iter()
+        .map(|it| (it.index, make(it.centroid())))
+        .unzip();
+    let bvh = Bvh {
+        nodes,
+        order,
+        ..Bvh::default()
+    };
+    (bvh, sorted)
+}
+
 /// [`build_binary`] over `n` primitives whose centroids are `centroid(i)`, with their
 /// boxes in `bounds`, or `None` when every box is its centroid (points): callers that
 /// hold their primitives need no copy of the centroids.
@@ -127,9 +148,25 @@ pub fn build_with(
     bounds: Option<&[Aabb]>,
     options: BuildOptions,
 ) -> Bvh {
+    let (nodes, items) = build_records(n, centroid, bounds, options);
+    let order = items.par_iter().map(|it| it.index).collect();
+    Bvh {
+        nodes,
+        order,
+        ..Bvh::default()
+    }
+}
+
+/// The nodes of [`build_with`] and the build's records in leaf order.
+fn build_records(
+    n: usize,
+    centroid: impl Fn(usize) -> Vec3 + Sync,
+    bounds: Option<&[Aabb]>,
+    options: BuildOptions,
+) -> (Vec<Node>, Vec<Item>) {
     assert!(bounds.is_none_or(|b| b.len() == n));
     if n == 0 {
-        return Bvh::default();
+        return (Vec::new(), Vec::new());
     }
     let input = Input {
         bounds,
@@ -147,13 +184,7 @@ pub fn build_with(
         .map(|chunk| range_bounds(&input, chunk))
         .reduce(|| RangeBounds::EMPTY, RangeBounds::union);
     let built = build_range(&input, &mut items, 0, rb);
-    let nodes = built.flatten();
-    let order = items.par_iter().map(|it| it.index).collect();
-    Bvh {
-        nodes,
-        order,
-        ..Bvh::default()
-    }
+    (built.flatten(), items)
 }
 
 /// Bounds of the primitives and of the centroids of `items`.
@@ -437,6 +468,13 @@ mod tests {
                     let what = format!("{shape}, n = {n}, leaf size {leaf_size}");
                     let points = build_binary_points(&pts, options);
                     check(&points, &bounds, leaf_size, &what);
+                    // The points read off the records are the inputs in leaf order, to
+                    // the bit, with the same tree.
+                    let (with, sorted) = build_binary_points_with(&pts, options, |p| p);
+                    assert_eq!((&with.nodes, &with.order), (&points.nodes, &points.order));
+                    let bits = |p: &Vec3| p.to_array().map(f32::to_bits);
+                    let expected = points.order.iter().map(|&i| bits(&pts[i as usize]));
+                    assert!(sorted.iter().map(bits).eq(expected), "{what}");
                     // The general entry point detects points and builds the same tree.
                     let general = build_binary(&bounds, &pts, options);
                     assert_eq!(points.nodes, general.nodes, "{what}");

@@ -13,7 +13,9 @@ mod sweep;
 mod validate;
 pub mod wide;
 
-pub use build::{BuildOptions, build, build_binary, build_binary_points, build_with};
+pub use build::{
+    BuildOptions, build, build_binary, build_binary_points, build_binary_points_with, build_with,
+};
 pub use moments::Moments4;
 pub use validate::validate;
 pub use wide::{Node4, Root};

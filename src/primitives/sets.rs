@@ -41,19 +41,11 @@ pub struct PrimitiveSet<P> {
 
 impl PrimitiveSet<Point> {
     /// The points of `vertices`, built straight from the vertex array (the points are
-    /// made once, in leaf order).
+    /// made once, in leaf order, from the build's records).
     pub fn from_vertices(vertices: &[Vec3], options: BuildOptions) -> Self {
         let t = Instant::now();
-        let bvh = bvh::build_binary_points(vertices, options);
-        Self::finish(
-            bvh,
-            |i| Point {
-                p: vertices[i as usize],
-            },
-            1.0,
-            t,
-            0.0,
-        )
+        let (bvh, sorted) = bvh::build_binary_points_with(vertices, options, |p| Point { p });
+        Self::finish(bvh, sorted, 1.0, t, 0.0)
     }
 }
 
@@ -73,24 +65,14 @@ impl<P: Primitive> PrimitiveSet<P> {
             let bounds: Vec<Aabb> = prims.par_iter().map(|p| p.bounds()).collect();
             bvh::build_with(prims.len(), centroid, Some(&bounds), options)
         };
-        Self::finish(bvh, |i| prims[i as usize], max_adj, t, prim_seconds)
+        let sorted = bvh.order.par_iter().map(|&i| prims[i as usize]).collect();
+        Self::finish(bvh, sorted, max_adj, t, prim_seconds)
     }
 
-    /// Puts the primitives (`source(i)` for input index `i`) in leaf order and makes the
-    /// wide form, in parallel (the wide form reads only the nodes).
-    fn finish(
-        mut bvh: Bvh,
-        source: impl Fn(u32) -> P + Sync,
-        max_adj: f64,
-        t: Instant,
-        prim_seconds: f64,
-    ) -> Self {
-        let order = std::mem::take(&mut bvh.order);
-        let (sorted, ()) = rayon::join(
-            || order.par_iter().map(|&i| source(i)).collect::<Vec<P>>(),
-            || bvh.make_wide(),
-        );
-        bvh.order = order;
+    /// Makes the wide form (and, for points, the moments) of `bvh` over the primitives
+    /// in leaf order, `sorted`.
+    fn finish(mut bvh: Bvh, sorted: Vec<P>, max_adj: f64, t: Instant, prim_seconds: f64) -> Self {
+        bvh.make_wide();
         if P::IS_POINT {
             bvh.moments = bvh::moments::build(&bvh.wide, |i| sorted[i].centroid());
         }
