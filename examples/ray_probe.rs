@@ -9,15 +9,18 @@
 //! `eval::reach` and the exact per-term bound, against the distance left to the hit),
 //! `cost` (microseconds per evaluation: value, value with free distance, gradient; at
 //! points far apart, and at the same point again, whose data the caches then hold),
-//! `hitcheck` (every pixel's ray traced on its own; the exact value, beta 0, at each hit
-//! point in epsilons: how far the hits sit from the exact zero set, and the share
-//! outside the hit band).
+//! `hitcheck` (every pixel's ray traced by tiles, as renders trace them; the exact
+//! value, beta 0, at each hit point in epsilons: how far the hits sit from the exact
+//! zero set, and the share outside the hit band). A last argument `fixed-step-beta`
+//! turns the tiles' learned step beta (`render::step_beta`) off.
 use glam::DVec3;
 use rayon::prelude::*;
 use smoothtrace::eval::evaluate_value;
 use smoothtrace::render::TracerOptions;
 use smoothtrace::render::build::build_scene;
-use smoothtrace::render::tracer::{RayStats, Tracer};
+use smoothtrace::render::cone::{ConeStats, Tile, trace_tile};
+use smoothtrace::render::image::TILE;
+use smoothtrace::render::tracer::{RayResult, RayStats, Tracer};
 use smoothtrace::reports::quantile;
 use smoothtrace::scene::Scene;
 use std::path::Path;
@@ -30,14 +33,19 @@ fn main() {
     scene.image.width = w;
     scene.image.height = h;
     let built = build_scene(&scene).expect("build");
-    let opts = TracerOptions::new(built.epsilon, scene.render.max_steps);
+    // A last argument `fixed-step-beta` turns the tiles' learned step beta off.
+    let learn_step_beta = args.last().map(String::as_str) != Some("fixed-step-beta");
+    let opts = TracerOptions {
+        learn_step_beta,
+        ..TracerOptions::new(built.epsilon, scene.render.max_steps)
+    };
     let tracer = Tracer::new(&built.objects, opts);
     let eps = built.epsilon;
     let cam = &built.camera;
     let obj = &built.objects[0];
     let sets = obj.set_refs();
-    if let (Some(px), Some(py)) = (args.get(4), args.get(5)) {
-        let (px, py): (u32, u32) = (px.parse().unwrap(), py.parse().unwrap());
+    let pixel = |i: usize| args.get(i).and_then(|a| a.parse::<u32>().ok());
+    if let (Some(px), Some(py)) = (pixel(4), pixel(5)) {
         let (o, d) = cam.ray(px, py);
         let mut p = obj.params;
         p.beta = 0.0;
@@ -72,17 +80,31 @@ fn main() {
     if args.get(4).map(String::as_str) == Some("hitcheck") {
         let mut p = obj.params;
         p.beta = 0.0;
-        let mut v: Vec<f64> = (0..h)
+        // Traced by tiles from the camera's clearance, as renders trace them (cone
+        // marches, neighbours' balls, the tile's learned step beta).
+        let (s0, _) = tracer.field(cam.origin(), &mut RayStats::default());
+        let tiles: Vec<Tile> = (0..h.div_ceil(TILE))
+            .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty)))
+            .map(|(tx, ty)| Tile {
+                x0: tx * TILE,
+                y0: ty * TILE,
+                w: TILE.min(w - tx * TILE),
+                h: TILE.min(h - ty * TILE),
+            })
+            .collect();
+        let mut v: Vec<f64> = tiles
             .into_par_iter()
-            .flat_map_iter(|py| {
-                let (tracer, sets, p) = (&tracer, &sets, &p);
-                (0..w)
-                    .filter_map(move |px| {
-                        let (o, d) = cam.ray(px, py);
-                        let hit = tracer.trace(o, d, 0.0).hit?;
-                        Some(evaluate_value(sets, hit.point, p).s / eps)
-                    })
-                    .collect::<Vec<_>>()
+            .flat_map_iter(|tile| {
+                let mut values = Vec::new();
+                let mut out = |_, _, r: RayResult| {
+                    if let Some(hit) = r.hit {
+                        values.push(evaluate_value(&sets, hit.point, &p).s / eps);
+                    }
+                };
+                let mut cones = ConeStats::default();
+                let sub = [0.5, 0.5];
+                trace_tile(&tracer, cam, tile, sub, s0, true, &mut cones, &mut out);
+                values
             })
             .collect();
         if v.is_empty() {

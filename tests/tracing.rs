@@ -236,12 +236,13 @@ fn reach_steps_find_the_surface_plain_steps_find() {
     }
 }
 
-/// A tile's step beta learned from its refinements (`render::step_beta`): as close to the
-/// exact surface as steps at the fixed step beta, and on the soft point clouds (the
-/// sphere of points, the deer at alpha 1), where the coarse step values fall several
-/// epsilons below the hit beta's and nearly every hit ray pays a refinement, with fewer
-/// of them and fewer full evaluations. The tiles of the edge and triangle scenes of
-/// `THIN` learn nothing (their gaps stay under half an epsilon) and render as before.
+/// A tile's step beta switched to the hit beta where its refinements find the coarse
+/// steps lagging by several epsilons (`render::step_beta`): as close to the exact
+/// surface as steps at the fixed step beta, and on the soft point clouds (the sphere of
+/// points, the deer at alpha 1), where nearly every hit ray paid a refinement, with
+/// fewer of them and fewer full evaluations; the bunny's points (gaps of 1-3 epsilons)
+/// keep the coarse steps nearly everywhere. The tiles of the edge and triangle scenes
+/// of `THIN` never switch and render as before.
 #[test]
 fn learned_step_beta_finds_the_surface_the_fixed_one_finds() {
     let fixed = |o| TracerOptions {
@@ -275,27 +276,29 @@ fn learned_step_beta_finds_the_surface_the_fixed_one_finds() {
             b.only_one
         );
         assert!(
-            a.p50.unwrap() <= b.p50.unwrap() + 0.5 && a.p99.unwrap() <= b.p99.unwrap() + 1.0,
+            a.p50.unwrap() <= b.p50.unwrap() + 0.1 && a.p99.unwrap() <= b.p99.unwrap() + 1.0,
             "{name}: depth error against the exact surface, learned {a:?} vs fixed {b:?}"
         );
-        fewer(
-            name,
-            "refinements",
-            learned.stats.refinements,
-            steady.stats.refinements,
-        );
-        // The bunny's points learn less (gaps of 1-3 epsilons, 4.85 -> 3.84 at this size).
-        let share = if name == "bunny_points.toml" {
-            0.9
-        } else {
-            0.8
-        };
         assert!(
-            per_hit(&learned) < share * per_hit(&steady),
+            per_hit(&learned) <= per_hit(&steady),
             "{name}: {:.2} vs {:.2} full evaluations per hit ray",
             per_hit(&learned),
             per_hit(&steady)
         );
+        if name != "bunny_points.toml" {
+            fewer(
+                name,
+                "refinements",
+                learned.stats.refinements,
+                steady.stats.refinements,
+            );
+            assert!(
+                per_hit(&learned) < 0.8 * per_hit(&steady),
+                "{name}: {:.2} vs {:.2} full evaluations per hit ray",
+                per_hit(&learned),
+                per_hit(&steady)
+            );
+        }
     }
     for name in THIN {
         let s = scene(name, 160, 90);

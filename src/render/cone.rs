@@ -106,7 +106,7 @@ pub fn trace_tile(
 }
 
 /// Traces every pixel of `tile` ray by ray from `t_start`, each past its neighbours'
-/// balls if `near` is given, at the tile's learned step beta (`render::step_beta`).
+/// balls if `near` is given, at the tile's step beta (`render::step_beta`).
 #[allow(clippy::too_many_arguments)]
 fn trace_rays(
     tracer: &Tracer,
@@ -140,7 +140,7 @@ struct March<'m, 't> {
     stats: &'m mut ConeStats,
     /// The balls of the tile's last rays (`render::neighbours`), if used.
     near: Option<&'m mut Neighbours>,
-    /// The tile's learned step beta (`render::step_beta`).
+    /// The tile's step beta (`render::step_beta`).
     steps: &'m mut StepBeta,
     out: &'m mut dyn FnMut(u32, u32, RayResult),
 }

@@ -34,8 +34,8 @@ pub struct TracerOptions {
     /// still a lower bound, so the step is safe, at a fraction of the terms. Any value in
     /// the hit band or below is taken again at the hit beta before it decides anything.
     pub step_beta: f64,
-    /// The step beta of a tile's later rays moves towards the hit beta where its rays'
-    /// refinements find the step values several epsilons low (`render::step_beta`).
+    /// A tile's later rays step at the hit beta once a refinement of its rays finds the
+    /// step value four or more epsilons low (`render::step_beta`).
     pub learn_step_beta: bool,
     /// Steps by the free distance along the ray from the terms' slopes (`eval::reach`;
     /// objects of points only), at least the plain step.

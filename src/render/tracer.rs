@@ -64,9 +64,8 @@
 //!     are made at the coarser `TracerOptions::step_beta` (1 by default): a lower bound
 //!     too, so the step is safe, at 60-75% of the terms near the surface; a value in
 //!     the hit band or below is taken again at the hit beta before it decides anything.
-//!     Where those refinements find the step values several epsilons low (soft point
-//!     clouds), the tile's later rays step at a beta closer to the hit beta
-//!     (`render::step_beta`).
+//!     Where a refinement finds the step value four or more epsilons low (soft point
+//!     clouds), the tile's later rays step at the hit beta (`render::step_beta`).
 
 use super::neighbours::Neighbours;
 use super::object::TraceObject;
@@ -415,8 +414,8 @@ impl<'a> Tracer<'a> {
     /// [`Tracer::trace`] for a ray of a tile: it starts past the stretch that the empty
     /// balls of the tile's last rays certify, and leaves its own balls for the next
     /// (`render::neighbours`), if `near` is given; its step evaluations are made at the
-    /// tile's learned step beta, and its refinement, if any, teaches the tile
-    /// (`render::step_beta`).
+    /// tile's step beta, and its refinement, if any, may switch the tile's steps to the
+    /// hit beta (`render::step_beta`).
     pub fn trace_in_tile(
         &self,
         o: DVec3,
@@ -479,7 +478,7 @@ impl<'a> Tracer<'a> {
         let mut accurate = false;
         // The tile's step beta (`render::step_beta`): at the hit beta, no refinement.
         let step_beta = steps.as_deref().copied().unwrap_or_default();
-        let refine = self.refine && step_beta.share() < 1.0;
+        let refine = self.refine && !step_beta.at_hit_beta();
         while t <= t_max {
             if stats.evals + stats.coarse_evals >= self.options.max_steps {
                 stats.exhausted = true;
@@ -599,10 +598,10 @@ impl<'a> Tracer<'a> {
             } else {
                 0.5 * f.s
             };
-            // A step evaluation at the hit beta (the tile's learned step beta, item 10)
+            // A step evaluation at the hit beta (the tile's steps switched, item 10)
             // costs what a hit evaluation costs but for the gradient: it asks for it
             // sooner, so that fewer hits need a second traversal for the normal.
-            let within = if step_beta.share() >= 1.0 {
+            let within = if step_beta.at_hit_beta() {
                 PREDICT_AT_HIT_BETA
             } else {
                 PREDICT
