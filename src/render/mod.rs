@@ -1,5 +1,6 @@
 //! Rendering: objects ready to trace, the sphere tracer (SPEC 7), the image loop.
 
+mod backtrack;
 pub mod cone;
 pub mod neighbours;
 pub mod object;

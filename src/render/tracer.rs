@@ -12,7 +12,8 @@
 //! 4. Hit when `|s| <= epsilon`. A step that lands below `-epsilon` (the smooth distance
 //!    is not a lower bound of the distance to its own zero set) is backtracked: the
 //!    crossing is bracketed by the last positive `t` and this one and found by the
-//!    Illinois (safeguarded regula falsi) method to within `epsilon`.
+//!    Illinois (safeguarded regula falsi) method to within `epsilon`
+//!    (`render::backtrack`).
 //! 5. Far from the surface, steps are bound steps: a coarser Barnes-Hut sum
 //!    (`coarse_beta`, cheaper, and a lower bound of the scene's sum, so the steps stay
 //!    safe) until it falls below `coarse_threshold * epsilon` (`coarse_threshold_points`
@@ -124,8 +125,8 @@ pub struct RayResult {
 }
 
 #[derive(Clone, Copy)]
-struct FieldSample {
-    s: f64,
+pub(super) struct FieldSample {
+    pub(super) s: f64,
     object: usize,
     /// Gradient of the winning object's smooth distance, when it was asked for.
     grad: Option<DVec3>,
@@ -138,7 +139,7 @@ struct FieldSample {
 /// What an evaluation is for: a bound step at a coarser beta, or a full-accuracy value
 /// with or without the gradient.
 #[derive(Clone, Copy, PartialEq)]
-enum Want {
+pub(super) enum Want {
     Bound(f64),
     Value,
     Gradient,
@@ -305,7 +306,7 @@ impl<'a> Tracer<'a> {
     }
 
     /// The scene field at `x` for `want`; full evaluations at the hit beta if `accurate`.
-    fn sample(
+    pub(super) fn sample(
         &self,
         x: DVec3,
         stats: &mut RayStats,
@@ -617,7 +618,14 @@ impl<'a> Tracer<'a> {
         RayResult { hit: None, stats }
     }
 
-    fn hit(&self, o: DVec3, d: DVec3, t: f64, f: &FieldSample, stats: &mut RayStats) -> Hit {
+    pub(super) fn hit(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        t: f64,
+        f: &FieldSample,
+        stats: &mut RayStats,
+    ) -> Hit {
         let point = o + t * d;
         let grad = match f.grad {
             Some(g) => g,
@@ -629,83 +637,5 @@ impl<'a> Tracer<'a> {
             normal: grad.normalize_or_zero(),
             object: f.object,
         }
-    }
-
-    /// The paper's backtracking: from `t` (where `s < -epsilon`) march back by epsilon
-    /// until `s >= -epsilon`.
-    fn step_back(&self, o: DVec3, d: DVec3, mut t: f64, stats: &mut RayStats) -> Option<Hit> {
-        let eps = self.options.epsilon;
-        while stats.evals + stats.coarse_evals < self.options.max_steps {
-            t -= eps;
-            let before = stats.evals;
-            let f = self.sample(
-                o + t * d,
-                stats,
-                Want::Value,
-                true,
-                None,
-                StepBeta::default(),
-            );
-            stats.backtracks += stats.evals - before;
-            if f.s >= -eps {
-                return Some(self.hit(o, d, t, &f, stats));
-            }
-        }
-        stats.exhausted = true;
-        None
-    }
-
-    /// Finds the crossing in `[lo, hi]` (`s(lo) > 0 > s(hi)`) by the Illinois method.
-    fn backtrack(
-        &self,
-        o: DVec3,
-        d: DVec3,
-        (mut lo, mut s_lo): (f64, f64),
-        (mut hi, mut s_hi): (f64, f64),
-        stats: &mut RayStats,
-    ) -> Option<Hit> {
-        let eps = self.options.epsilon;
-        let mut side = 0i8;
-        let mut last = None;
-        for _ in 0..64 {
-            if stats.evals + stats.coarse_evals >= self.options.max_steps {
-                stats.exhausted = true;
-                break;
-            }
-            let mut t = (lo * s_hi - hi * s_lo) / (s_hi - s_lo);
-            if !(t > lo && t < hi) {
-                t = 0.5 * (lo + hi);
-            }
-            let before = stats.evals;
-            let f = self.sample(
-                o + t * d,
-                stats,
-                Want::Value,
-                true,
-                None,
-                StepBeta::default(),
-            );
-            stats.backtracks += stats.evals - before;
-            if f.s.abs() <= eps || hi - lo <= eps {
-                return Some(self.hit(o, d, t, &f, stats));
-            }
-            last = Some((t, f));
-            if f.s > 0.0 {
-                lo = t;
-                s_lo = f.s;
-                if side == 1 {
-                    s_hi *= 0.5;
-                }
-                side = 1;
-            } else {
-                hi = t;
-                s_hi = f.s;
-                if side == -1 {
-                    s_lo *= 0.5;
-                }
-                side = -1;
-            }
-        }
-        last.map(|(t, f)| self.hit(o, d, t, &f, stats))
     }
 }
