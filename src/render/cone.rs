@@ -75,8 +75,9 @@ impl Tile {
 /// calls `out(px, py, result)` for each. The ray of pixel `(px, py)` passes through the
 /// image-plane point `(px + sub[0], py + sub[1])` (`[0.5, 0.5]`: pixel centres; other
 /// offsets in `[0, 1)` give one sub-pixel sample per pixel for anti-aliasing, the cone
-/// built from the same rays). With `cone = false` every ray is traced on its own (the
-/// reference the cone march must reproduce).
+/// built from the same rays). With `cone = false` every ray is traced from `t_start`
+/// without the march and the neighbours' balls (the reference the cone march must
+/// reproduce); the tile's step beta (`render::step_beta`) applies either way.
 #[allow(clippy::too_many_arguments)]
 pub fn trace_tile(
     tracer: &Tracer,
