@@ -29,7 +29,7 @@ use smoothtrace::render::TracerOptions;
 use smoothtrace::render::build::{BuildError, build_scene};
 use smoothtrace::render::image::Rendered;
 use smoothtrace::render::pipeline::{in_pool, render_built, render_scene};
-use smoothtrace::reports::compare::compare_depths;
+use smoothtrace::reports::compare::{DepthDiff, compare_depths};
 use smoothtrace::scene::Scene;
 use std::path::PathBuf;
 
@@ -190,6 +190,23 @@ fn relaxed_steps_certified_from_behind_find_the_surface_on_point_clouds() {
     }
 }
 
+/// Renders `s` with the tracer defaults (`on`) and with `off`, and the exact sum's
+/// surface (beta 0) with `off`; returns both renders and their depth differences from
+/// the exact one in epsilons.
+fn against_exact(
+    s: &Scene,
+    off: impl Fn(TracerOptions) -> TracerOptions + Send + Sync + Copy,
+) -> (Rendered, Rendered, DepthDiff, DepthDiff) {
+    let (eps, _, on) = render(s, |o| o);
+    let (_, _, plain) = render(s, off);
+    let mut exact = s.clone();
+    exact.render.beta = 0.0;
+    let (_, _, exact) = render(&exact, off);
+    let a = compare_depths(&on.depth, &exact.depth, 1.0, eps);
+    let b = compare_depths(&plain.depth, &exact.depth, 1.0, eps);
+    (on, plain, a, b)
+}
+
 #[test]
 fn reach_steps_find_the_surface_plain_steps_find() {
     let names = point_scenes();
@@ -198,17 +215,8 @@ fn reach_steps_find_the_surface_plain_steps_find() {
         ..o
     };
     for name in names {
-        let s = scene(name, 240, 135);
-        let (eps, _, reach) = render(&s, |o| o);
-        let (_, _, stepped) = render(&s, plain);
         // Both against the exact sum's surface (beta 0, plain steps), in epsilons.
-        let mut exact = s.clone();
-        exact.render.beta = 0.0;
-        let (_, _, exact) = render(&exact, plain);
-        let (a, b) = (
-            compare_depths(&reach.depth, &exact.depth, 1.0, eps),
-            compare_depths(&stepped.depth, &exact.depth, 1.0, eps),
-        );
+        let (reach, stepped, a, b) = against_exact(&scene(name, 240, 135), plain);
         eprintln!("{name}: vs exact, reach steps {a:?}\n   plain steps {b:?}");
         assert!(
             a.only_one <= b.only_one + reach.stats.rays as usize / 500,
@@ -221,17 +229,16 @@ fn reach_steps_find_the_surface_plain_steps_find() {
             "{name}: depth error against the exact surface, reach {a:?} vs plain {b:?}"
         );
         // The point of it: fewer full evaluations on the rays that hit.
-        let per_hit = |r: &Rendered| r.stats.hit_evals as f64 / r.stats.hits as f64;
         eprintln!(
             "{name}: full evaluations per hit ray {:.2} -> {:.2}",
-            per_hit(&stepped),
-            per_hit(&reach)
+            stepped.stats.evals_per_hit(),
+            reach.stats.evals_per_hit()
         );
         assert!(
-            per_hit(&reach) < 0.8 * per_hit(&stepped),
+            reach.stats.evals_per_hit() < 0.8 * stepped.stats.evals_per_hit(),
             "{name}: {:.2} vs {:.2} full evaluations per hit ray",
-            per_hit(&reach),
-            per_hit(&stepped)
+            reach.stats.evals_per_hit(),
+            stepped.stats.evals_per_hit()
         );
     }
 }
@@ -250,24 +257,14 @@ fn learned_step_beta_finds_the_surface_the_fixed_one_finds() {
         ..o
     };
     for name in point_scenes() {
-        let s = scene(name, 240, 135);
-        let (eps, _, learned) = render(&s, |o| o);
-        let (_, _, steady) = render(&s, fixed);
-        let mut exact = s.clone();
-        exact.render.beta = 0.0;
-        let (_, _, exact) = render(&exact, fixed);
-        let (a, b) = (
-            compare_depths(&learned.depth, &exact.depth, 1.0, eps),
-            compare_depths(&steady.depth, &exact.depth, 1.0, eps),
-        );
-        let per_hit = |r: &Rendered| r.stats.hit_evals as f64 / r.stats.hits as f64;
+        let (learned, steady, a, b) = against_exact(&scene(name, 240, 135), fixed);
         eprintln!(
             "{name}: vs exact, learned {a:?}\n   fixed {b:?}\n   refinements {} -> {}, \
              full evaluations per hit ray {:.2} -> {:.2}",
             steady.stats.refinements,
             learned.stats.refinements,
-            per_hit(&steady),
-            per_hit(&learned)
+            steady.stats.evals_per_hit(),
+            learned.stats.evals_per_hit()
         );
         assert!(
             a.only_one <= b.only_one + learned.stats.rays as usize / 500,
@@ -280,10 +277,10 @@ fn learned_step_beta_finds_the_surface_the_fixed_one_finds() {
             "{name}: depth error against the exact surface, learned {a:?} vs fixed {b:?}"
         );
         assert!(
-            per_hit(&learned) <= per_hit(&steady),
+            learned.stats.evals_per_hit() <= steady.stats.evals_per_hit(),
             "{name}: {:.2} vs {:.2} full evaluations per hit ray",
-            per_hit(&learned),
-            per_hit(&steady)
+            learned.stats.evals_per_hit(),
+            steady.stats.evals_per_hit()
         );
         if name != "bunny_points.toml" {
             fewer(
@@ -293,10 +290,10 @@ fn learned_step_beta_finds_the_surface_the_fixed_one_finds() {
                 steady.stats.refinements,
             );
             assert!(
-                per_hit(&learned) < 0.8 * per_hit(&steady),
+                learned.stats.evals_per_hit() < 0.8 * steady.stats.evals_per_hit(),
                 "{name}: {:.2} vs {:.2} full evaluations per hit ray",
-                per_hit(&learned),
-                per_hit(&steady)
+                learned.stats.evals_per_hit(),
+                steady.stats.evals_per_hit()
             );
         }
     }
