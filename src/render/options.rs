@@ -49,6 +49,11 @@ pub struct TracerOptions {
     /// in the paper's renderer.
     pub clip: bool,
     pub backtrack: Backtrack,
+    /// A hit at a positive value `s` is placed at `t + s`, one more sphere-tracing step
+    /// that needs no evaluation: the ball of radius `s` around the sample is free of the
+    /// surface, so the hit stays in front of it, closer to it (tracer module docs,
+    /// item 4). Off, the hit is the sample that came within epsilon (the paper's).
+    pub final_step: bool,
 }
 
 /// How a step that overshoots into the negative band is resolved.
@@ -79,6 +84,7 @@ impl TracerOptions {
             reach_behind: true,
             clip: true,
             backtrack: Backtrack::Illinois,
+            final_step: true,
         }
     }
 
@@ -98,6 +104,7 @@ impl TracerOptions {
             reach_behind: false,
             clip: false,
             backtrack: Backtrack::FixedStep,
+            final_step: false,
             ..TracerOptions::new(epsilon, max_steps)
         }
     }

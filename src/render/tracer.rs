@@ -13,7 +13,14 @@
 //!    is not a lower bound of the distance to its own zero set) is backtracked: the
 //!    crossing is bracketed by the last positive `t` and this one and found by the
 //!    Illinois (safeguarded regula falsi) method to within `epsilon`
-//!    (`render::backtrack`).
+//!    (`render::backtrack`). A hit at a positive value `s` is placed at `t + s`: the
+//!    value is a lower bound of the exact smooth distance, which is 1-Lipschitz, so the
+//!    ball of radius `s` around the sample holds no point of the exact zero set, and the
+//!    step to its far side along the ray needs no evaluation. The hit stays in front of
+//!    the surface and comes closer to it: the exact value at the hits, 480x270, mean
+//!    0.514 -> 0.194 epsilons on the bunny's triangles, 0.404 -> 0.333 on its points,
+//!    0.595 -> 0.518 on the deer at alpha 2 (`ray_probe ... hitcheck`). The normal is
+//!    the sample's gradient when it carried one (at most epsilon away).
 //! 5. Far from the surface, steps are bound steps: a coarser Barnes-Hut sum
 //!    (`coarse_beta`, cheaper, and a lower bound of the scene's sum, so the steps stay
 //!    safe) until it falls below `coarse_threshold * epsilon` (`coarse_threshold_points`
@@ -626,6 +633,12 @@ impl<'a> Tracer<'a> {
         f: &FieldSample,
         stats: &mut RayStats,
     ) -> Hit {
+        // One more step, free: the sample's ball is empty (module docs, item 4).
+        let t = if self.options.final_step {
+            t + f.s.max(0.0)
+        } else {
+            t
+        };
         let point = o + t * d;
         let grad = match f.grad {
             Some(g) => g,
