@@ -247,12 +247,12 @@ fn reach_steps_find_the_surface_plain_steps_find() {
 }
 
 /// A tile's step beta switched to the hit beta where its refinements find the coarse
-/// steps lagging by several epsilons (`render::step_beta`): as close to the exact
+/// steps lagging by an epsilon or more (`render::step_beta`): as close to the exact
 /// surface as steps at the fixed step beta, and on the soft point clouds (the sphere of
-/// points, the deer at alpha 1), where nearly every hit ray paid a refinement, with
-/// fewer of them and fewer full evaluations; the bunny's points (gaps of 1-3 epsilons)
-/// keep the coarse steps nearly everywhere. The tiles of the edge and triangle scenes
-/// of `THIN` never switch and render as before.
+/// points, the deer at alpha 1) and the bunny's points (gaps of 1-3 epsilons), where
+/// many hit rays paid a refinement, with fewer of them and at most 80% of the full
+/// evaluations. The tiles of the edge and triangle scenes of `THIN` never switch and
+/// render as before.
 #[test]
 fn learned_step_beta_finds_the_surface_the_fixed_one_finds() {
     let fixed = |o| TracerOptions {
@@ -285,20 +285,18 @@ fn learned_step_beta_finds_the_surface_the_fixed_one_finds() {
             learned.stats.evals_per_hit(),
             steady.stats.evals_per_hit()
         );
-        if name != "bunny_points.toml" {
-            fewer(
-                name,
-                "refinements",
-                learned.stats.refinements,
-                steady.stats.refinements,
-            );
-            assert!(
-                learned.stats.evals_per_hit() < 0.8 * steady.stats.evals_per_hit(),
-                "{name}: {:.2} vs {:.2} full evaluations per hit ray",
-                learned.stats.evals_per_hit(),
-                steady.stats.evals_per_hit()
-            );
-        }
+        fewer(
+            name,
+            "refinements",
+            learned.stats.refinements,
+            steady.stats.refinements,
+        );
+        assert!(
+            learned.stats.evals_per_hit() < 0.8 * steady.stats.evals_per_hit(),
+            "{name}: {:.2} vs {:.2} full evaluations per hit ray",
+            learned.stats.evals_per_hit(),
+            steady.stats.evals_per_hit()
+        );
     }
     for name in THIN {
         let s = scene(name, 160, 90);
@@ -309,9 +307,10 @@ fn learned_step_beta_finds_the_surface_the_fixed_one_finds() {
     }
 }
 
-/// The final step (`TracerOptions::final_step`): a hit at a positive value `s` is placed
-/// one ball further along the ray, at no cost. Against the hits without it, ray by ray:
-/// never behind them, at most epsilon further, never past the exact (beta 0) zero set
+/// The final step (`TracerOptions::final_step`): a hit at a positive value `s` is moved
+/// on along the ray by its ball (or its free distance, up to `4 s`), at no cost. Against
+/// the hits without it, ray by ray: never behind them, at most four epsilons further,
+/// never past the exact (beta 0) zero set
 /// where the hit without it was in front of it, and closer to it on average (exact value
 /// at the hits, by a twentieth of epsilon or more). Triangles (torus), edges (hex torus, thin
 /// tubes) and points.
@@ -353,7 +352,7 @@ fn the_final_step_brings_hits_closer_to_the_exact_surface_never_past_it() {
                     continue;
                 };
                 assert!(
-                    a.t >= b.t && a.t - b.t <= eps,
+                    a.t >= b.t && a.t - b.t <= 4.0 * eps,
                     "{name} ({px}, {py}): hit at {} with the final step, {} without",
                     a.t,
                     b.t

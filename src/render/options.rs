@@ -35,7 +35,7 @@ pub struct TracerOptions {
     /// the hit band or below is taken again at the hit beta before it decides anything.
     pub step_beta: f64,
     /// A tile's later rays step at the hit beta once a refinement of its rays finds the
-    /// step value four or more epsilons low (`render::step_beta`).
+    /// step value one or more epsilons low (`render::step_beta`).
     pub learn_step_beta: bool,
     /// Steps by the free distance along the ray from the terms' slopes (`eval::reach`;
     /// objects of points only), at least the plain step.
@@ -49,10 +49,11 @@ pub struct TracerOptions {
     /// in the paper's renderer.
     pub clip: bool,
     pub backtrack: Backtrack,
-    /// A hit at a positive value `s` is placed at `t + s`, one more sphere-tracing step
-    /// that needs no evaluation: the ball of radius `s` around the sample is free of the
-    /// surface, so the hit stays in front of it, closer to it (tracer module docs,
-    /// item 4). Off, the hit is the sample that came within epsilon (the paper's).
+    /// A hit at a positive value `s` is moved on by one more sphere-tracing step that
+    /// needs no evaluation (`s`, or on point clouds the free distance along the ray up
+    /// to `4 s`): that stretch is free of the surface, so the hit stays in front of it,
+    /// closer to it (tracer module docs, item 4). Off, the hit is the sample that came
+    /// within epsilon (the paper's).
     pub final_step: bool,
 }
 
