@@ -51,7 +51,7 @@ pub struct TracerOptions {
     pub backtrack: Backtrack,
     /// A hit at a positive value `s` is moved on by one more sphere-tracing step that
     /// needs no evaluation (`s`, or on point clouds the free distance along the ray up
-    /// to `4 s`): that stretch is free of the surface, so the hit stays in front of it,
+    /// to `2 s`): that stretch is free of the surface, so the hit stays in front of it,
     /// closer to it (tracer module docs, item 4). Off, the hit is the sample that came
     /// within epsilon (the paper's).
     pub final_step: bool,
