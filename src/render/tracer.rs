@@ -603,7 +603,7 @@ impl<'a> Tracer<'a> {
                 return RayResult { hit, stats };
             }
             if let Some(n) = balls.as_deref_mut() {
-                n.note(x, f.s);
+                n.note_along(x, f.s, d, f.reach);
             }
             let step = stepper.step(prev, t, f.s, f.reach, Kind::Full);
             // The value at the next sample, if the field keeps its slope along the ray.
