@@ -38,12 +38,15 @@
 //!    takes the far steps once for a whole tile, and start past the stretch that the
 //!    empty balls of the tile's last rays already certify (`render::neighbours`).
 //! 6. Full-accuracy evaluations prune with a tolerance tied to epsilon: subtrees whose
-//!    terms hold together less than `tol = min(0.005 alpha epsilon, 1e-2)` of the sum are
-//!    skipped and covered from above, which lowers `s` by at most `2 tol / alpha`, 1% of
-//!    epsilon (`eval::smooth`; queries keep the default 1e-10). On the point clouds this
-//!    visits 25-30% fewer leaves for the same march (the lidar 7% fewer again than with
-//!    the earlier cap at 1e-3; the other rows of Table 1 it reaches, the torus, bunny,
-//!    bucky ball and deer at alpha 4, change by at most 2%).
+//!    terms hold together less than `tol = min(0.025 alpha epsilon, 1e-2)` of the sum
+//!    are skipped and covered from above, which lowers `s` by at most `2 tol / alpha`, 5%
+//!    of epsilon (`eval::smooth`; queries keep the default 1e-10). The cap binds where
+//!    `alpha epsilon` exceeds 0.4 (every mesh of Table 1, and the lidar at 0.58). On the
+//!    point clouds this visits 25-30% fewer leaves for the same march than the default
+//!    (the lidar 7% fewer again than with the earlier cap at 1e-3); a factor of 0.025
+//!    instead of 0.005 another 9-13% fewer (960x540: lidar 169.6 -> 147.9, deer at
+//!    alpha 2 54.0 -> 49.4 leaves per ray), for an exact value at the hits 0.02-0.03
+//!    epsilons higher (a trade paid for by the final step, item 4; README, round twelve).
 //! 7. The normal is the normalised gradient at the hit. Steps need only the value, so
 //!    they use value-only evaluations; an evaluation predicted to hit (its predecessor's
 //!    value within two epsilons, or a linear extrapolation of the last two values
@@ -163,6 +166,11 @@ const PREDICT: f64 = 2.0;
 /// evaluations per hit ray, a third of its hits needed a second traversal before).
 const PREDICT_AT_HIT_BETA: f64 = 4.0;
 
+/// The tracer's pruning tolerance is `min(PRUNE_SHARE alpha epsilon, PRUNE_CAP)` (module
+/// docs, item 6): values lower by at most `2 PRUNE_SHARE epsilon`.
+const PRUNE_SHARE: f64 = 0.025;
+const PRUNE_CAP: f64 = 1e-2;
+
 /// The final step's longest reach, in units of the hit's value `s` (module docs, item
 /// 4): a ray that meets the surface at a slope of 1/2 or more (30 degrees) crosses it
 /// within `2 s`. The free distance may certify more, but on a ray that skims bumpy ground
@@ -180,7 +188,7 @@ pub struct Tracer<'a> {
     reach: Vec<f64>,
     /// Pruning tolerance per object: subtrees holding together less than this share of
     /// the sum are skipped, which lowers `s` by at most `2 tol / alpha`; chosen so that
-    /// is at most 1% of epsilon (and at most 1e-2 of the sum).
+    /// is at most 5% of epsilon (and at most 1e-2 of the sum).
     tolerance: Vec<f64>,
     /// Opening parameter per object of the evaluations that decide hits (item 9).
     hit_beta: Vec<f64>,
@@ -211,7 +219,7 @@ impl<'a> Tracer<'a> {
         }
         let tolerance = objects
             .iter()
-            .map(|o| (0.005 * o.params.alpha * options.epsilon).min(1e-2))
+            .map(|o| (PRUNE_SHARE * o.params.alpha * options.epsilon).min(PRUNE_CAP))
             .collect();
         // Objects made of points only: hits at the scene's beta (item 9), coarser steps
         // (item 10) and an earlier end of the bound steps (item 5).
