@@ -25,9 +25,9 @@
 //! where those of coarse steps sit once the hit is moved on by its free distance
 //! (`TracerOptions::final_step`): the exact value at the hits of the bunny's points
 //! (480x270, mean) is 0.274 epsilons with every tile's steps left coarse and 0.281 with
-//! the switch at 1 epsilon, where most of its tiles switch. (Without that step a switch left the hits higher in the
-//! band, 0.39 -> 0.54: the coarse steps' lag sent a ray one fine step deeper.) Every
-//! step is still a Barnes-Hut sum, a lower bound of the exact one, so every step stays
+//! the switch at 1 epsilon, where most of its tiles switch. (Without that step a switch
+//! left the hits higher in the band, 0.39 -> 0.54: the coarse steps' lag sent a ray one
+//! fine step deeper.) Every step is still a Barnes-Hut sum, a lower bound of the exact one, so every step stays
 //! safe, and hits are decided at `b_h` as before. Only the tile's own rays (same tile
 //! and sample pass) teach it, so a render does not depend on how tiles are spread over
 //! threads, and a crop traces its tiles as the whole image does. (Edges and triangles
