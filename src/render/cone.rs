@@ -93,7 +93,10 @@ pub fn trace_tile(
     if !cone || tracer.options().coarse_beta <= 0.0 {
         return trace_rays(tracer, camera, tile, sub, t_start, None, &mut steps, out);
     }
-    let mut near = tracer.options().neighbours.then(Neighbours::new);
+    let mut near = tracer
+        .options()
+        .neighbours
+        .then(|| Neighbours::new(pitch(camera, tile, sub)));
     let mut march = March {
         tracer,
         camera,
@@ -126,6 +129,21 @@ fn trace_rays(
             out(px, py, r);
         }
     }
+}
+
+/// The smallest distance per unit of `t` between the rays of two neighbouring pixels of
+/// `tile`, at its corners (the pitch shrinks away from the image centre).
+fn pitch(camera: &Camera, tile: Tile, sub: [f64; 2]) -> f64 {
+    let (x1, y1) = (tile.x0 + tile.w - 1, tile.y0 + tile.h - 1);
+    [(tile.x0, tile.y0), (x1, tile.y0), (tile.x0, y1), (x1, y1)]
+        .into_iter()
+        .map(|(px, py)| {
+            let d = ray(camera, px, py, sub).1;
+            let across = ray(camera, px + 1, py, sub).1;
+            let down = ray(camera, px, py + 1, sub).1;
+            (across - d).length().min((down - d).length())
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The ray of pixel `(px, py)` through its sub-pixel position `sub`.
