@@ -657,9 +657,10 @@ impl<'a> Tracer<'a> {
             None => self.gradient(f.object, o + t * d, stats),
         };
         // One more step, free, where the field falls along the ray: the sample's ball, or
-        // its free distance along the ray, is empty (module docs, item 4).
+        // its free distance along the ray, is empty (module docs, item 4). (A free
+        // distance is never below `s`, and never NaN; `max` keeps it so.)
         let t = if self.options.final_step && f.s > 0.0 && grad.dot(d) < 0.0 {
-            t + f.reach.min(FINAL_REACH * f.s)
+            t + f.reach.max(f.s).min(FINAL_REACH * f.s)
         } else {
             t
         };
