@@ -243,3 +243,43 @@ impl March<'_, '_> {
         );
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pitch_is_the_smallest_step_between_neighbouring_pixel_rays() {
+        // 100x100 pixels over 90 degrees: at the centre neighbouring rays are 2/100 apart
+        // per unit of distance, towards the corners less.
+        let cam = Camera::new(DVec3::ZERO, DVec3::NEG_Z, DVec3::Y, 90.0, 100, 100).unwrap();
+        let sub = [0.5, 0.5];
+        let centre = Tile {
+            x0: 48,
+            y0: 48,
+            w: 4,
+            h: 4,
+        };
+        let corner = Tile {
+            x0: 0,
+            y0: 0,
+            w: 4,
+            h: 4,
+        };
+        let (p_centre, p_corner) = (pitch(&cam, centre, sub), pitch(&cam, corner, sub));
+        assert!((p_centre - 0.02).abs() < 0.01 * 0.02, "{p_centre}");
+        assert!(p_corner < 0.7 * p_centre, "{p_corner} vs {p_centre}");
+        // No two pixels' rays of a tile are closer than its pitch.
+        for (tile, p) in [(centre, p_centre), (corner, p_corner)] {
+            let pixels: Vec<(u32, u32)> = (tile.y0..tile.y0 + tile.h)
+                .flat_map(|y| (tile.x0..tile.x0 + tile.w).map(move |x| (x, y)))
+                .collect();
+            for (i, &a) in pixels.iter().enumerate() {
+                for &b in &pixels[i + 1..] {
+                    let gap = (ray(&cam, a.0, a.1, sub).1 - ray(&cam, b.0, b.1, sub).1).length();
+                    assert!(gap >= p * (1.0 - 1e-9), "{a:?} {b:?}: {gap} < {p}");
+                }
+            }
+        }
+    }
+}
