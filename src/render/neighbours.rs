@@ -127,15 +127,14 @@ impl Neighbours {
         t
     }
 
-    /// Records a sample of the ray being traced: the field is at least `s` at `x`.
+    /// Records a sample of the ray being traced: the field is at least `s` at `x`. Its ball
+    /// is kept for the next rays if it can reach one (module docs).
     pub fn note(&mut self, x: DVec3, s: f64) {
-        self.keep(x, s);
-    }
-
-    /// Keeps the ball of radius `s` around `x` for the next rays if it can reach one.
-    fn keep(&mut self, centre: DVec3, radius: f64) {
-        if radius > 0.0 && radius > self.min_share * (centre - self.origin).length() {
-            self.current.push(Ball { centre, radius });
+        if s > 0.0 && s > self.min_share * (x - self.origin).length() {
+            self.current.push(Ball {
+                centre: x,
+                radius: s,
+            });
         }
     }
 
@@ -147,7 +146,7 @@ impl Neighbours {
         if s > 0.0 && reach > s {
             for j in 1..=FREE_CONE_BALLS {
                 let share = j as f64 / (FREE_CONE_BALLS + 1) as f64;
-                self.keep(x + share * reach * u, (1.0 - share) * s);
+                self.note(x + share * reach * u, (1.0 - share) * s);
             }
         }
     }
