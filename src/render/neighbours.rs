@@ -1,6 +1,7 @@
 //! Empty balls shared between neighbouring rays of a tile (SPEC 7, after the tile's cone
 //! march): a ray starts past the stretch of it that the balls of the rays traced just
-//! before it already certify.
+//! before it already certify, and moves on through them again wherever its own steps
+//! reach them.
 //!
 //! Every sample a ray takes at `x` with a lower bound `s > 0` of the field certifies the
 //! ball of radius `s` around `x` free of the surface (the assumption every
@@ -9,7 +10,11 @@
 //! (x - o) . d` the foot of the centre on the ray, `h = sqrt(s^2 - |x - o - t_c d|^2)`.
 //! The new ray starts at `t0` (the tile's cone-marched start, itself certified); while a
 //! chord contains `t0`, `t0` moves to the chord's end. The chords so chained are inside
-//! the balls, so the skipped stretch is as safe as the tracer's own steps.
+//! the balls, so the skipped stretch is as safe as the tracer's own steps. Chords past a
+//! gap are not lost: whenever the ray's own certified stretch reaches one (the end of a
+//! step's ball or free distance), the ray moves on through the chain that starts there
+//! ([`Neighbours::advance`]). Rays skimming a surface meet their neighbours' balls all
+//! along it, not only at the start.
 //!
 //! Primary rays of neighbouring pixels are a pixel's footprint apart at the surface
 //! (about 6 epsilons at 1920x1080 at the centre of the lidar scan), and the samples
@@ -88,6 +93,11 @@ pub struct Neighbours {
     min_share: f64,
     /// The origin of the ray being traced (the camera).
     origin: DVec3,
+    /// The first of `chords` (sorted by start) not yet chained.
+    next: usize,
+    /// The end of the last chain: `[t, reached]` is certified for every certified `t`
+    /// at or past the point the chain started from.
+    reached: f64,
 }
 
 impl Neighbours {
@@ -100,8 +110,9 @@ impl Neighbours {
         }
     }
 
-    /// The farthest `t >= t0` such that `[t0, t]` on the ray `o + t d` (unit `d`) lies in
-    /// a chain of the kept balls (`t0` if no ball contains it).
+    /// Starts the ray `o + t d` (unit `d`) at a certified `t0`: the farthest `t >= t0`
+    /// such that `[t0, t]` lies in a chain of the kept balls (`t0` if no ball contains
+    /// it). Their chords further on are kept for [`Neighbours::advance`].
     pub fn start(&mut self, o: DVec3, d: DVec3, t0: f64) -> f64 {
         self.origin = o;
         self.chords.clear();
@@ -117,13 +128,27 @@ impl Neighbours {
             }
         }
         self.chords.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-        let mut t = t0;
-        for &(a, b) in &self.chords {
+        self.next = 0;
+        self.reached = t0;
+        self.advance(t0)
+    }
+
+    /// The farthest point the ray being traced reaches from `t` through the chords of
+    /// the kept balls, for a `t` up to which the ray is certified free (the end of a
+    /// sample's ball or free distance), and never behind a `t` given before (the
+    /// tracer's certified stretch only grows; a rejected relaxed step goes back to its
+    /// end, which this call then moves on again to where the chain reached).
+    pub fn advance(&mut self, t: f64) -> f64 {
+        // A chain reached from an earlier certified point covers `[t, reached]`.
+        let mut t = t.max(self.reached);
+        while let Some(&(a, b)) = self.chords.get(self.next) {
             if a > t {
                 break;
             }
             t = t.max(b);
+            self.next += 1;
         }
+        self.reached = t;
         t
     }
 
@@ -209,6 +234,45 @@ mod tests {
         assert_eq!(n.start(o, d, 20.0), 20.0);
         // A ray farther than the radius meets no ball.
         assert_eq!(n.start(DVec3::new(-10.0, 1.4, 0.0), d, 10.0), 10.0);
+    }
+
+    #[test]
+    fn chords_past_a_gap_are_chained_when_the_ray_reaches_them() {
+        let mut n = Neighbours::new(0.0);
+        // Balls of radius 1 at x = 0, 1.5 (a chain), 4 and 5.5 (another, past a gap), 9.
+        for x in [0.0, 1.5, 4.0, 5.5, 9.0] {
+            n.note(DVec3::new(x, 0.3, 0.0), 1.0);
+        }
+        n.finish_ray();
+        let (o, d) = (DVec3::new(-10.0, 0.0, 0.0), DVec3::X);
+        let h = (1.0f64 - 0.09).sqrt();
+        let first = n.start(o, d, 9.5);
+        assert!((first - (11.5 + h)).abs() < 1e-6, "{first}");
+        // A step certified to a point in the gap moves nowhere.
+        assert_eq!(n.advance(12.8), 12.8);
+        // One certified into the second chain moves to its end.
+        let second = n.advance(14.0 - h + 0.01);
+        assert!((second - (15.5 + h)).abs() < 1e-6, "{second}");
+        // A rejected relaxed step goes back to a certified point inside that chain: the
+        // chain's end still stands.
+        assert_eq!(n.advance(14.5), second);
+        // Chains consumed are not walked again; the last ball is reached on its own.
+        assert_eq!(n.advance(17.0), 17.0);
+        let last = n.advance(19.0 - h + 0.01);
+        assert!((last - (19.0 + h)).abs() < 1e-6, "{last}");
+        // Everything between a certified point and where it was moved is inside a ball.
+        let inside = |t: f64| {
+            n.balls
+                .iter()
+                .any(|b| (o + t * d - b.centre).length() <= b.radius)
+        };
+        for (a, b) in [
+            (9.5, first),
+            (14.0 - h + 0.01, second),
+            (19.0 - h + 0.01, last),
+        ] {
+            assert!((0..=1000).all(|k| inside(a + (b - a) * k as f64 / 1000.0)));
+        }
     }
 
     #[test]

@@ -83,6 +83,13 @@ impl Stepper {
         Some(tp + sp)
     }
 
+    /// The step just returned by [`Stepper::step`] was lengthened to a point certified
+    /// by other means (the neighbours' balls): nothing is left for the next sample to
+    /// cover. The slope stays: it was measured between samples.
+    pub(super) fn certified(&mut self) {
+        self.relaxed = false;
+    }
+
     /// The step to take from `t`, where the field is at least `s > 0`.
     /// `reach >= s` is the sample's certified free distance (`s` for a plain sample).
     pub(super) fn step(
