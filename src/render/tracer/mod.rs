@@ -81,6 +81,10 @@
 //!     Where a refinement finds the step value one or more epsilons low (soft point
 //!     clouds), the tile's later rays step at the hit beta (`render::step_beta`).
 
+mod sample;
+
+pub(super) use sample::{FieldSample, Want};
+
 use super::neighbours::Neighbours;
 use super::object::TraceObject;
 use super::options::{Backtrack, TracerOptions};
@@ -135,27 +139,6 @@ pub struct RayStats {
 pub struct RayResult {
     pub hit: Option<Hit>,
     pub stats: RayStats,
-}
-
-#[derive(Clone, Copy)]
-pub(super) struct FieldSample {
-    pub(super) s: f64,
-    object: usize,
-    /// Gradient of the winning object's smooth distance, when it was asked for.
-    grad: Option<DVec3>,
-    /// Free distance along the ray (`eval::reach`; `s` when not asked for).
-    reach: f64,
-    /// Free distance back along the ray (`s` when not asked for, or not shorter).
-    reach_back: f64,
-}
-
-/// What an evaluation is for: a bound step at a coarser beta, or a full-accuracy value
-/// with or without the gradient.
-#[derive(Clone, Copy, PartialEq)]
-pub(super) enum Want {
-    Bound(f64),
-    Value,
-    Gradient,
 }
 
 /// An evaluation is predicted to hit (and carries the gradient) when its predecessor's
@@ -309,138 +292,6 @@ impl<'a> Tracer<'a> {
 
     pub fn options(&self) -> &TracerOptions {
         &self.options
-    }
-
-    /// The scene field at `x` (the minimum over objects) and the object attaining it.
-    pub fn field(&self, x: DVec3, stats: &mut RayStats) -> (f64, usize) {
-        let f = self.sample(x, stats, Want::Value, false, None, StepBeta::default());
-        (f.s, f.object)
-    }
-
-    /// A lower bound of the scene field at `x` from a Barnes-Hut sum at opening
-    /// parameter `beta` (at least the scene's): cheaper than [`Tracer::field`] for a
-    /// larger `beta`, counted as a bound step.
-    pub fn bound(&self, x: DVec3, beta: f64, stats: &mut RayStats) -> f64 {
-        self.sample(
-            x,
-            stats,
-            Want::Bound(beta),
-            false,
-            None,
-            StepBeta::default(),
-        )
-        .s
-    }
-
-    /// The gradient of object `k`'s smooth distance at `x` (one evaluation, at the hit
-    /// beta).
-    pub fn gradient(&self, k: usize, x: DVec3, stats: &mut RayStats) -> DVec3 {
-        let obj = &self.objects[k];
-        let mut alpha = obj.params.alpha;
-        loop {
-            let sample = obj.evaluate(
-                &self.sets[k],
-                x,
-                alpha,
-                self.hit_beta[k],
-                self.tolerance[k],
-                true,
-                None,
-                false,
-            );
-            stats.evals += 1;
-            stats.eval.add(&sample.stats);
-            if sample.s.is_finite() || alpha <= 1e-300 {
-                return sample.grad;
-            }
-            alpha /= 10.0;
-            stats.falloffs += 1;
-        }
-    }
-
-    /// The scene field at `x` for `want`; full evaluations at the hit beta if `accurate`.
-    pub(super) fn sample(
-        &self,
-        x: DVec3,
-        stats: &mut RayStats,
-        want: Want,
-        accurate: bool,
-        along: Option<Along>,
-        step_beta: StepBeta,
-    ) -> FieldSample {
-        let mut best = FieldSample {
-            s: f64::INFINITY,
-            object: 0,
-            grad: None,
-            reach: f64::INFINITY,
-            reach_back: f64::INFINITY,
-        };
-        // With several objects a step is the smallest value (no free distance).
-        let along = along.filter(|_| self.objects.len() == 1 && !matches!(want, Want::Bound(_)));
-        let (coarse, grad) = match want {
-            Want::Bound(beta) => (Some(beta), false),
-            Want::Value => (None, false),
-            Want::Gradient => (None, true),
-        };
-        for (k, obj) in self.objects.iter().enumerate() {
-            if self.objects.len() > 1 && obj.lower_bound(x, self.reach[k]) >= best.s {
-                continue;
-            }
-            let mut alpha = obj.params.alpha;
-            let evaluate = |alpha: f64, stats: &mut RayStats| {
-                let beta = match coarse {
-                    Some(b) => b.max(obj.params.beta),
-                    None if accurate => self.hit_beta[k],
-                    None => step_beta.beta(self.step_beta[k], self.hit_beta[k]),
-                };
-                let sample = obj.evaluate(
-                    &self.sets[k],
-                    x,
-                    alpha,
-                    beta,
-                    self.tolerance[k],
-                    grad,
-                    along,
-                    coarse.is_some(),
-                );
-                if coarse.is_some() {
-                    stats.coarse_evals += 1;
-                    stats.coarse_leaves += sample.stats.leaves();
-                } else {
-                    stats.evals += 1;
-                    stats.step_evals += u32::from(!accurate && beta > obj.params.beta);
-                }
-                stats.eval.add(&sample.stats);
-                sample
-            };
-            let mut sample = evaluate(alpha, stats);
-            // Alpha falloff (naive mode): a smaller alpha gives a smaller, finite s.
-            while sample.s == f64::INFINITY && alpha > 1e-300 {
-                alpha /= 10.0;
-                stats.falloffs += 1;
-                sample = evaluate(alpha, stats);
-            }
-            if sample.s < best.s {
-                // A falloff's gradient and free distances are those of a smaller alpha:
-                // the gradient is recomputed at the hit, the steps are plain.
-                let own_alpha = alpha == obj.params.alpha;
-                let free = |len: f64| {
-                    if own_alpha {
-                        len.max(sample.s)
-                    } else {
-                        sample.s
-                    }
-                };
-                best = FieldSample {
-                    s: sample.s,
-                    object: k,
-                    grad: (grad && own_alpha).then_some(sample.grad),
-                    reach: free(sample.reach),
-                    reach_back: free(sample.reach_back),
-                };
-            }
-        }
-        best
     }
 
     /// An upper bound of the ray parameter at which any ray from `o` leaves the grown
