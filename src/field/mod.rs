@@ -25,7 +25,7 @@
 //!   Culling ([`FieldOptions::cull`], without band): per-tile upper bounds of the
 //!   distance (one nearest query at each tile centre, plus the tile's half diagonal)
 //!   cut each polygon to the tiles its site can win; this never removes the closest
-//!   feature, so the result stays exact. The algorithm is in `linfac.rs`, the domains
+//!   feature, so the result stays exact. The algorithm is in `linfac/`, the domains
 //!   in `sites.rs`.
 //! - `Bvh`: one exact nearest-primitive query per voxel on the engine's BVH (bounded
 //!   by the previous voxel's distance plus the spacing).
