@@ -36,6 +36,10 @@
 //! all others `+inf` (f32 `INFINITY`, also in the `.npy`); every linfac domain is cut to
 //! the band (exactly, row by row), and the BVH query is bounded by it.
 //!
+//! Boxes and chunks: [`FieldPlan`] prepares a field once (sites, BVH) and computes any
+//! box of voxels of its grid ([`FieldSource`], `plan.rs`); [`zarr`] writes a volume as a
+//! chunked Zarr v3 array one chunk at a time, so its memory is that of a few chunks.
+//!
 //! [`DistanceField::sample`] interpolates trilinearly; [`DistanceField::lower_bound`]
 //! gives `d(x) >= d(v) - |x - v|` over the 8 surrounding voxel centres `v`, which a
 //! sphere tracer can use to skip empty space (SPEC 7).

@@ -212,13 +212,13 @@ fn first_difference(path: &str, a: &Value, b: &Value) -> Option<(String, String,
             }
             return None;
         }
-        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => {
-            if x.iter()
-                .zip(y)
-                .all(|(p, q)| first_difference(path, p, q).is_none())
-            {
-                return None;
-            }
+        (Value::Array(x), Value::Array(y))
+            if x.len() == y.len()
+                && x.iter()
+                    .zip(y)
+                    .all(|(p, q)| first_difference(path, p, q).is_none()) =>
+        {
+            return None;
         }
         (Value::Number(x), Value::Number(y)) => {
             if let (Some(p), Some(q)) = (x.as_f64(), y.as_f64())
