@@ -118,10 +118,11 @@ pub fn run(
         attributes: zarr_io::grid_attributes(grid, field_attributes(a, mesh, method, options)),
     };
     let total = spec.chunk_count();
-    // The memory of a few chunks in flight and the setup, not of the volume.
+    // The memory of one strip of chunks along x, two chunks and the setup, not of the
+    // volume.
     let [cz, cy, cx] = chunk;
-    let chunk_grid = Grid::new(grid.min, grid.max, [cx, cy, cz])?;
-    chunk_grid.check_memory(
+    let strip = Grid::new(grid.min, grid.max, [grid.res[0], cy, cz])?;
+    strip.check_memory(
         options.memory_limit,
         setup_bytes(mesh) + 8 * (cx * cy * cz) as u64,
     )?;

@@ -270,14 +270,7 @@ impl ZarrArray {
             match std::fs::create_dir(path) {
                 Ok(()) => {}
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && path.is_dir() => {
-                    let empty = std::fs::read_dir(path)
-                        .map_err(|source| ZarrError::Read {
-                            path: path.into(),
-                            source,
-                        })?
-                        .next()
-                        .is_none();
-                    if !empty && !path.join("zarr.json").exists() {
+                    if !is_empty_dir(path)? && !path.join("zarr.json").exists() {
                         return Err(ZarrError::Corrupt {
                             path: path.into(),
                             reason: "a non-empty folder without zarr.json".into(),
@@ -526,6 +519,15 @@ fn write_metadata(path: &Path, spec: &ZarrSpec) -> Result<(), ZarrError> {
     Ok(())
 }
 
+/// Whether the folder `path` has no entries.
+fn is_empty_dir(path: &Path) -> Result<bool, ZarrError> {
+    let mut entries = std::fs::read_dir(path).map_err(|source| ZarrError::Read {
+        path: path.into(),
+        source,
+    })?;
+    Ok(entries.next().is_none())
+}
+
 /// Removes an existing Zarr array (a folder with `zarr.json`) or an empty folder for
 /// `--force`; refuses files and other folders.
 fn remove_array(path: &Path) -> Result<(), ZarrError> {
@@ -540,14 +542,7 @@ fn remove_array(path: &Path) -> Result<(), ZarrError> {
     {
         return Err(refuse("exists and is not a folder"));
     }
-    let empty = std::fs::read_dir(path)
-        .map_err(|source| ZarrError::Read {
-            path: path.into(),
-            source,
-        })?
-        .next()
-        .is_none();
-    if !empty && !path.join("zarr.json").is_file() {
+    if !is_empty_dir(path)? && !path.join("zarr.json").is_file() {
         return Err(refuse("is a folder without zarr.json, not a Zarr array"));
     }
     std::fs::remove_dir_all(path).map_err(|source| ZarrError::Create {
