@@ -20,6 +20,7 @@ pub mod framing;
 pub mod geometry;
 pub mod las;
 pub mod limits;
+pub mod load;
 pub mod matcap;
 pub mod mesh;
 pub mod output;

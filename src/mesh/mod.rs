@@ -96,19 +96,14 @@ fn extension(path: &Path) -> String {
 }
 
 impl Mesh {
-    /// Reads a mesh, choosing the reader by extension (`.obj`, `.ply`, `.stl`, any case).
-    /// Lidar files (`.las`, `.laz`) give their points with the default filters (noise
-    /// classes dropped), recentred on the header's box centre ([`crate::las`]).
-    /// The path must be a regular file of at most [`crate::limits::MAX_INPUT_BYTES`].
+    /// Reads a mesh file, choosing the reader by extension (`.obj`, `.ply`, `.stl`, any
+    /// case). Lidar files are read by [`crate::las`]; [`crate::load::load_mesh`] reads
+    /// either kind. The path must be a regular file of at most
+    /// [`crate::limits::MAX_INPUT_BYTES`].
     ///
     /// Errors name the file and what was wrong; a mesh with no vertices is an error.
     pub fn load(path: &Path) -> Result<Mesh, MeshError> {
         let ext = extension(path);
-        if matches!(ext.as_str(), "las" | "laz") {
-            let mesh = crate::las::read(path, &Default::default())?.mesh;
-            mesh.validate(path)?;
-            return Ok(mesh);
-        }
         if !matches!(ext.as_str(), "obj" | "ply" | "stl") {
             return Err(MeshError::UnknownExtension {
                 path: path.to_path_buf(),
