@@ -16,6 +16,7 @@ mod vertex_colours;
 
 pub use error::MeshError;
 
+use crate::colour::Linear;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::path::Path;
@@ -115,6 +116,31 @@ impl Mesh {
             source,
         })?;
         Mesh::from_bytes(bytes, path)
+    }
+
+    /// Reads a mesh and its per-vertex colours (see [`vertex_colours`]): `Ok((mesh, None))`
+    /// when the file has none. Errors name the file, and the property, vertex or line
+    /// of a colour that cannot be used.
+    pub fn load_with_vertex_colours(path: &Path) -> Result<(Mesh, Option<Vec<Linear>>), MeshError> {
+        let ext = extension(path);
+        if !matches!(ext.as_str(), "obj" | "ply") {
+            return Ok((Mesh::load(path)?, None));
+        }
+        let bytes = crate::limits::read_input_file(path).map_err(|source| MeshError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let (mut mesh, colours) = if ext == "ply" {
+            ply::parse_ply_coloured(&bytes, path, true)?
+        } else {
+            obj::parse_obj_coloured(&bytes, path, true)?
+        };
+        mesh.name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        mesh.validate(path)?;
+        Ok((mesh, colours))
     }
 
     /// Parses a whole mesh file held in memory, choosing the reader by the extension of
