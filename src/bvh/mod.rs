@@ -8,6 +8,7 @@
 
 mod bins;
 mod build;
+mod range;
 pub mod moments;
 mod sweep;
 mod validate;
