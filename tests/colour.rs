@@ -9,7 +9,8 @@
 mod common;
 
 use glam::DVec3;
-use smoothtrace::colour::{Colormap, SetColours, to_srgb8};
+use smoothtrace::colour::SetColours;
+use smoothtrace::rgb::{Colormap, to_srgb8};
 use smoothtrace::eval::EvalParams;
 use smoothtrace::eval::colour::colour_at;
 use smoothtrace::mesh::Mesh;

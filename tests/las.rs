@@ -7,7 +7,8 @@ mod common;
 
 use common::data_file;
 use glam::DVec3;
-use smoothtrace::colour::{self, Colormap, SetColours, palette, srgb8_to_linear};
+use smoothtrace::colour::SetColours;
+use smoothtrace::rgb::{self as colour, Colormap, palette, srgb8_to_linear};
 use smoothtrace::eval::EvalParams;
 use smoothtrace::eval::colour::colour_at;
 use smoothtrace::las::{self, ColorBy, LasFilters, LasOptions, Returns, Thin};

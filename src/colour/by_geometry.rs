@@ -13,7 +13,7 @@
 //!
 //! The lidar attributes (`rgb`, `intensity`, ...) are `crate::las::ColorBy`.
 
-use super::{Colormap, Linear};
+use crate::rgb::{Colormap, Linear};
 use crate::mesh::Mesh;
 
 /// Which geometric quantity colours an object.

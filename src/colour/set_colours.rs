@@ -4,7 +4,7 @@
 //!
 //! Built only when an object is coloured; the geometry's own arrays are not touched.
 
-use super::Linear;
+use crate::rgb::Linear;
 use crate::mesh::Mesh;
 use crate::primitives::{AnySet, PrimitiveKind};
 

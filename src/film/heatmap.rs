@@ -6,7 +6,7 @@
 //! a handful of pathological rays would otherwise wash the picture out. Pixels above it
 //! take the top colour, and the top label says "≥".
 
-use crate::colour::Colormap;
+use crate::rgb::Colormap;
 use plotters::prelude::*;
 
 /// Width of the panel holding the colour bar and its labels, in pixels.

@@ -19,7 +19,7 @@ pub mod layout_check;
 pub use attributes::ColorBy;
 pub use filter::{FilterCount, LasFilters, NOISE_CLASSES, Returns, Thin};
 
-use crate::colour::{Colormap, Linear};
+use crate::rgb::{Colormap, Linear};
 use crate::mesh::{Mesh, MeshError};
 use attributes::AttributeColumn;
 use filter::{Record, Stream, VoxelThin};

@@ -16,7 +16,7 @@ mod vertex_colours;
 
 pub use error::MeshError;
 
-use crate::colour::Linear;
+use crate::rgb::Linear;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::path::Path;

@@ -24,7 +24,7 @@
 
 use super::vertex_colours::{self, PLY_COLOUR_NAMES};
 use super::{Mesh, MeshError, ply_binary, ply_check};
-use crate::colour::Linear;
+use crate::rgb::Linear;
 use glam::Vec3;
 use ply_rs_bw::parser::{ParseError, Parser, Reader};
 use ply_rs_bw::ply::{

@@ -24,7 +24,7 @@
 
 #[cfg(doc)]
 use super::Mesh;
-use crate::colour::srgb_to_linear;
+use crate::rgb::srgb_to_linear;
 
 /// The PLY spellings of the three colour channels, in the order they are looked for.
 pub(super) const PLY_COLOUR_NAMES: [[&str; 3]; 3] = [

@@ -11,7 +11,8 @@
 use super::object::TraceObject;
 use super::tracer::Hit;
 use crate::colour::by_geometry::normal_colour;
-use crate::colour::{Linear, SetColours, srgb8_to_linear, to_srgb8};
+use crate::colour::SetColours;
+use crate::rgb::{Linear, srgb8_to_linear, to_srgb8};
 use crate::eval::colour::colour_at;
 
 /// The MatCap luminance that shows the albedo unchanged.
