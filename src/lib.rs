@@ -2,8 +2,9 @@
 //! clouds, edge meshes and triangle meshes. See `ARCHITECTURE.md` for the data flow and
 //! `SPEC.md` (shared) for the math.
 //!
-//! Data flows one way: [`mesh`] (files, [`procedural`] shapes) -> [`primitives`] (sets
-//! with valences and weights) -> [`bvh`] -> [`eval`] (smooth distance, nearest) ->
+//! Data flows one way: [`mesh`] and [`las`] files (read through [`load`]), [`procedural`]
+//! shapes -> [`bvh`] -> [`primitives`] (sets with valences, weights and their BVH) ->
+//! [`eval`] (smooth distance, nearest) ->
 //! [`render`] (tracer, image loop, with [`camera`] and [`matcap`]), configured by
 //! [`scene`] files. The [`reports`] (bench, sweep, stability) and the exact distance
 //! volumes of [`field`] (SPEC 9) call the same library; [`api`] serves callers that hold

@@ -8,12 +8,12 @@ mod common;
 use common::data_file;
 use glam::DVec3;
 use smoothtrace::colour::SetColours;
-use smoothtrace::rgb::{self as colour, Colormap, palette, srgb8_to_linear};
 use smoothtrace::eval::EvalParams;
 use smoothtrace::eval::colour::colour_at;
 use smoothtrace::las::{self, ColorBy, LasFilters, LasOptions, Returns, Thin};
 use smoothtrace::mesh::{Mesh, MeshError};
 use smoothtrace::primitives::{AnySet, PrimitiveKind};
+use smoothtrace::rgb::{self as colour, Colormap, palette, srgb8_to_linear};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
@@ -427,7 +427,8 @@ fn lidar_gives_points_only() {
             "{e}"
         );
     }
-    let (mesh, origin) = smoothtrace::load::load_with_origin(&laz, &[PrimitiveKind::Points]).unwrap();
+    let (mesh, origin) =
+        smoothtrace::load::load_with_origin(&laz, &[PrimitiveKind::Points]).unwrap();
     assert!(!mesh.vertices.is_empty() && origin.x > 6e5);
     // In a scene: the primitives key is named, with its line.
     let text = format!(

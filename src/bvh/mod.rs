@@ -8,8 +8,8 @@
 
 mod bins;
 mod build;
-mod range;
 pub mod moments;
+mod range;
 mod sweep;
 mod validate;
 pub mod wide;

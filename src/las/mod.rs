@@ -19,8 +19,8 @@ pub mod layout_check;
 pub use attributes::ColorBy;
 pub use filter::{FilterCount, LasFilters, NOISE_CLASSES, Returns, Thin};
 
-use crate::rgb::{Colormap, Linear};
 use crate::mesh::{Mesh, MeshError};
+use crate::rgb::{Colormap, Linear};
 use attributes::AttributeColumn;
 use filter::{Record, Stream, VoxelThin};
 use glam::{DVec3, Vec3};
