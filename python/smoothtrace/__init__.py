@@ -291,6 +291,44 @@ class SmoothDistance:
         )
 
 
+def _field_args(
+    V, faces, edges, primitive, bounds, resolution, smooth_alpha, smooth_alpha_rel,
+    max_alpha, beta, method, band, threads,
+) -> tuple:
+    """The checked arguments of ``_native.distance_field`` and ``_native.FieldPlan``."""
+    kind = _primitives(primitive, faces, edges)
+    if len(kind) != 1:
+        raise ValueError(f"distance_field takes one primitive type (got {kind})")
+    if bounds is not None:
+        b = _np.asarray(bounds, dtype=_np.float64).reshape(-1)
+        if b.shape != (6,):
+            raise ValueError(
+                f"bounds must be [xmin, ymin, zmin, xmax, ymax, zmax] or [[min], [max]] (got {_np.shape(bounds)})"
+            )
+        bounds = [float(x) for x in b]
+    if isinstance(resolution, _numbers.Integral):
+        res = [int(resolution)]
+    else:
+        res = [int(r) for r in resolution]
+    if smooth_alpha is not None and smooth_alpha_rel is not None:
+        raise ValueError("give smooth_alpha or smooth_alpha_rel, not both")
+    return (
+        _coordinates(V, "V"),
+        _indices(faces, "faces", 3),
+        _indices(edges, "edges", 2),
+        kind[0],
+        bounds,
+        res,
+        str(method),
+        _number(smooth_alpha, "smooth_alpha"),
+        _number(smooth_alpha_rel, "smooth_alpha_rel"),
+        _number(max_alpha, "max_alpha"),
+        0.5 if beta is None else _number(beta, "beta"),
+        _number(band, "band"),
+        _threads(threads),
+    )
+
+
 def distance_field(
     V: Any,
     faces: Any = None,
@@ -336,36 +374,11 @@ def distance_field(
     return_bounds : bool
         Also return the grid's ``(2, 3)`` ``[min, max]`` corners.
     """
-    kind = _primitives(primitive, faces, edges)
-    if len(kind) != 1:
-        raise ValueError(f"distance_field takes one primitive type (got {kind})")
-    if bounds is not None:
-        b = _np.asarray(bounds, dtype=_np.float64).reshape(-1)
-        if b.shape != (6,):
-            raise ValueError(
-                f"bounds must be [xmin, ymin, zmin, xmax, ymax, zmax] or [[min], [max]] (got {_np.shape(bounds)})"
-            )
-        bounds = [float(x) for x in b]
-    if isinstance(resolution, _numbers.Integral):
-        res = [int(resolution)]
-    else:
-        res = [int(r) for r in resolution]
-    if smooth_alpha is not None and smooth_alpha_rel is not None:
-        raise ValueError("give smooth_alpha or smooth_alpha_rel, not both")
     field, lo, hi = _native.distance_field(
-        _coordinates(V, "V"),
-        _indices(faces, "faces", 3),
-        _indices(edges, "edges", 2),
-        kind[0],
-        bounds,
-        res,
-        str(method),
-        _number(smooth_alpha, "smooth_alpha"),
-        _number(smooth_alpha_rel, "smooth_alpha_rel"),
-        _number(max_alpha, "max_alpha"),
-        0.5 if beta is None else _number(beta, "beta"),
-        _number(band, "band"),
-        _threads(threads),
+        *_field_args(
+            V, faces, edges, primitive, bounds, resolution, smooth_alpha,
+            smooth_alpha_rel, max_alpha, beta, method, band, threads,
+        )
     )
     if return_bounds:
         return field, _np.array([lo, hi], dtype=_np.float64)

@@ -56,6 +56,8 @@ pub enum FieldError {
     Primitive(#[from] PrimitiveError),
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
+    #[error(transparent)]
+    Zarr(#[from] super::zarr::ZarrError),
 }
 
 /// `1.5 GiB`-style rendering of a byte count.
