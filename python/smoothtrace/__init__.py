@@ -26,15 +26,24 @@ the same message as the ``smoothtrace`` command line; files that cannot be read 
 
 from __future__ import annotations
 
-import numbers
-import os
-from typing import Any, List, Mapping, Optional, Sequence, Tuple, Union
+import numbers as _numbers
+import os as _os
+import typing as _typing
 
-import numpy as np
+import numpy as _np
 
 from . import _native
 from ._native import __version__
 
+if _typing.TYPE_CHECKING:
+    # Names for the annotations only (they are not evaluated at run time, see the
+    # `__future__` import), so that the package's namespace holds its API alone.
+    import os
+    from typing import Any, List, Mapping, Optional, Sequence, Tuple, Union
+
+    import numpy as np
+
+# The public API, one name a line; `dir(smoothtrace)` lists exactly these (see `__dir__`).
 __all__ = [
     "SmoothDistance",
     "distance_field",
@@ -44,38 +53,43 @@ __all__ = [
     "__version__",
 ]
 
+
+def __dir__() -> List[str]:
+    """The public API (``__all__``): what tab completion and ``dir(smoothtrace)`` show."""
+    return sorted(__all__)
+
 _KINDS = ("points", "edges", "triangles")
 
 
 def _coordinates(a: Any, name: str) -> np.ndarray:
     """`a` as a C-contiguous float64 array of shape (n, 3)."""
-    arr = np.asarray(a)
+    arr = _np.asarray(a)
     if arr.dtype.kind not in "fiu":
         raise ValueError(
             f"{name} must hold real numbers (a float or integer array), got dtype {arr.dtype}"
         )
     if arr.ndim != 2 or arr.shape[1] != 3:
         raise ValueError(f"{name} must have shape (n, 3), got {arr.shape}")
-    return np.ascontiguousarray(arr, dtype=np.float64)
+    return _np.ascontiguousarray(arr, dtype=_np.float64)
 
 
 def _indices(a: Any, name: str, width: int) -> Optional[np.ndarray]:
     """`a` as a C-contiguous int64 array of shape (n, width), or None."""
     if a is None:
         return None
-    arr = np.asarray(a)
+    arr = _np.asarray(a)
     if arr.size == 0 and arr.dtype.kind == "f":
         # An empty list becomes a float array; it holds no indices to misread.
-        arr = arr.astype(np.int64)
+        arr = arr.astype(_np.int64)
     if arr.dtype.kind not in "iu":
         raise ValueError(
             f"{name} must be an integer array of vertex indices, got dtype {arr.dtype}"
         )
     if arr.ndim != 2 or arr.shape[1] != width:
         raise ValueError(f"{name} must have shape (n, {width}), got {arr.shape}")
-    if arr.dtype.kind == "u" and arr.size and arr.max() > np.iinfo(np.int64).max:
+    if arr.dtype.kind == "u" and arr.size and arr.max() > _np.iinfo(_np.int64).max:
         raise ValueError(f"{name} holds vertex index {arr.max()}, out of range")
-    return np.ascontiguousarray(arr, dtype=np.int64)
+    return _np.ascontiguousarray(arr, dtype=_np.int64)
 
 
 def _primitives(
@@ -105,7 +119,7 @@ def _number(v: Any, name: str) -> Optional[float]:
     """A real number as float (None stays None); anything else is a ValueError."""
     if v is None:
         return None
-    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+    if isinstance(v, bool) or not isinstance(v, _numbers.Real):
         raise ValueError(f"{name} must be a number (got {v!r})")
     return float(v)
 
@@ -114,7 +128,7 @@ def _threads(threads: Any) -> Optional[int]:
     """A thread count as int (None: rayon's global pool); the range is checked in Rust."""
     if threads is None:
         return None
-    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
+    if isinstance(threads, bool) or not isinstance(threads, _numbers.Integral):
         raise ValueError(f"threads must be an integer (got {threads!r})")
     return int(threads)
 
@@ -286,13 +300,13 @@ def _field_args(
     if len(kind) != 1:
         raise ValueError(f"distance_field takes one primitive type (got {kind})")
     if bounds is not None:
-        b = np.asarray(bounds, dtype=np.float64).reshape(-1)
+        b = _np.asarray(bounds, dtype=_np.float64).reshape(-1)
         if b.shape != (6,):
             raise ValueError(
-                f"bounds must be [xmin, ymin, zmin, xmax, ymax, zmax] or [[min], [max]] (got {np.shape(bounds)})"
+                f"bounds must be [xmin, ymin, zmin, xmax, ymax, zmax] or [[min], [max]] (got {_np.shape(bounds)})"
             )
         bounds = [float(x) for x in b]
-    if isinstance(resolution, numbers.Integral):
+    if isinstance(resolution, _numbers.Integral):
         res = [int(resolution)]
     else:
         res = [int(r) for r in resolution]
@@ -367,7 +381,7 @@ def distance_field(
         )
     )
     if return_bounds:
-        return field, np.array([lo, hi], dtype=np.float64)
+        return field, _np.array([lo, hi], dtype=_np.float64)
     return field
 
 
@@ -421,7 +435,7 @@ def _camera(camera: Any):
         )
     vecs = []
     for name, v in zip(("origin", "target", "up"), parts[:3]):
-        a = np.asarray(v, dtype=np.float64).reshape(-1)
+        a = _np.asarray(v, dtype=_np.float64).reshape(-1)
         if a.shape != (3,):
             raise ValueError(f"camera {name} must be three numbers (got {v!r})")
         vecs.append([float(x) for x in a])

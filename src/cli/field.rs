@@ -116,7 +116,7 @@ pub fn run(a: FieldArgs) -> Result<()> {
     if let Some(p) = &a.preview {
         Output::check(p, IMAGE_8BIT, "the preview")?;
     }
-    let (mesh, origin) = smoothtrace::las::load_mesh(&a.mesh, &[a.primitive])?;
+    let (mesh, origin) = smoothtrace::load::load_with_origin(&a.mesh, &[a.primitive])?;
     if origin != DVec3::ZERO {
         note!(
             "{}: lidar points recentred: grid coordinates are file coordinates minus [{}, {}, {}]",
