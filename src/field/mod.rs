@@ -38,7 +38,8 @@
 //!
 //! Boxes and chunks: [`FieldPlan`] prepares a field once (sites, BVH) and computes any
 //! box of voxels of its grid ([`FieldSource`], `plan.rs`); [`zarr`] writes a volume as a
-//! chunked Zarr v3 array one chunk at a time, so its memory is that of a few chunks.
+//! chunked Zarr v3 array one row of chunks at a time, so its memory is that of a row,
+//! not of the volume.
 //!
 //! [`DistanceField::sample`] interpolates trilinearly; [`DistanceField::lower_bound`]
 //! gives `d(x) >= d(v) - |x - v|` over the 8 surrounding voxel centres `v`, which a
