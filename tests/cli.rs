@@ -227,14 +227,26 @@ fn render_writes_png_stats_and_depth() {
             && !line.contains("evaluations"),
         "summary line: {e}"
     );
-    assert!(line.len() < 100, "summary line of {} characters: {line}", line.len());
+    assert!(
+        line.len() < 100,
+        "summary line of {} characters: {line}",
+        line.len()
+    );
 }
 
 #[test]
 fn verbose_adds_the_counters_after_the_summary() {
     let d = tempdir_with(&[("s.toml", SCENE)]);
     let o = run(
-        &["render", "s.toml", "-o", "out.png", "--verbose", "--threads", "1"],
+        &[
+            "render",
+            "s.toml",
+            "-o",
+            "out.png",
+            "--verbose",
+            "--threads",
+            "1",
+        ],
         d.path(),
         None,
     );
@@ -246,7 +258,14 @@ fn verbose_adds_the_counters_after_the_summary() {
         .position(|l| l.contains(" rays/s -> out.png"))
         .unwrap_or_else(|| panic!("no summary line: {e}"));
     let counters = lines.get(at + 1).copied().unwrap_or_default();
-    for part in ["1 threads", "evaluations/ray", "per hit ray", "bound steps", "leaves/ray", "% hits"] {
+    for part in [
+        "1 threads",
+        "evaluations/ray",
+        "per hit ray",
+        "bound steps",
+        "leaves/ray",
+        "% hits",
+    ] {
         assert!(counters.contains(part), "counters line lacks {part:?}: {e}");
     }
 }

@@ -26,6 +26,7 @@ the same message as the ``smoothtrace`` command line; files that cannot be read 
 
 from __future__ import annotations
 
+import collections.abc as _abc
 import numbers as _numbers
 import os as _os
 import typing as _typing
@@ -42,6 +43,10 @@ if _typing.TYPE_CHECKING:
     from typing import Any, List, Mapping, Optional, Sequence, Tuple, Union
 
     import numpy as np
+
+# The `__future__` import above binds `annotations` in the module; the compiler flag is
+# all it is for.
+del annotations
 
 # The public API, one name a line; `dir(smoothtrace)` lists exactly these (see `__dir__`).
 __all__ = [
@@ -415,7 +420,7 @@ def _camera(camera: Any):
     """A camera dict as (origin, target, up, fov) for the extension, or None."""
     if camera is None:
         return None
-    if isinstance(camera, Mapping):
+    if isinstance(camera, _abc.Mapping):
         unknown = set(camera) - {"origin", "target", "up", "fov"}
         if unknown:
             raise ValueError(

@@ -231,7 +231,11 @@ mod tests {
             "{'descr': '<f4', 'fortran_order': False, 'shape': (7, 6, 5), }"
         );
         let one = npy_header_f4(&[5]);
-        assert!(std::str::from_utf8(&one[10..]).unwrap().contains("'shape': (5,)"));
+        assert!(
+            std::str::from_utf8(&one[10..])
+                .unwrap()
+                .contains("'shape': (5,)")
+        );
     }
 
     #[test]

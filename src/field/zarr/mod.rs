@@ -32,6 +32,12 @@ mod write;
 pub use store::{Codec, ZarrArray, ZarrError, ZarrSpec};
 pub use write::{ChunkRun, index_ranges, parse_chunks, write_chunks};
 
+impl From<ZarrError> for super::FieldError {
+    fn from(e: ZarrError) -> Self {
+        super::FieldError::Zarr(Box::new(e))
+    }
+}
+
 use super::grid::Grid;
 use serde_json::{Value, json};
 
