@@ -22,6 +22,7 @@
 //! the same layout as one depth-first pass.
 
 use super::Node;
+use glam::DVec3;
 use rayon::prelude::*;
 
 /// A child slot: the child is a leaf when `count > 0`.
@@ -45,6 +46,25 @@ pub struct Node4 {
     pub mid_diam2: [f32; 2],
     /// Number of primitives below each middle.
     pub mid_size: [u32; 2],
+}
+
+impl Node4 {
+    /// Squared distances from `x` to the four child boxes of a wide node (0 inside; `+inf`
+    /// for an unused slot, whose box is inverted), in f64, four lanes at a time.
+    #[inline(always)]
+    pub fn distances2(&self, x: DVec3) -> [f64; 4] {
+        let mut d2 = [0.0f64; 4];
+        for (a, xa) in x.to_array().into_iter().enumerate() {
+            for (k, d2k) in d2.iter_mut().enumerate() {
+                let below = self.min[a][k] as f64 - xa;
+                let above = xa - self.max[a][k] as f64;
+                let d = if below > above { below } else { above };
+                let d = if d > 0.0 { d } else { 0.0 };
+                *d2k += d * d;
+            }
+        }
+        d2
+    }
 }
 
 /// The root of the wide tree as a child slot (the traversal starts from it).

@@ -28,23 +28,6 @@ thread_local! {
     pub(super) static STACK: std::cell::RefCell<Vec<Entry>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-/// Squared distances from `x` to the four child boxes of a wide node (0 inside; `+inf`
-/// for an unused slot, whose box is inverted), in f64, four lanes at a time.
-#[inline(always)]
-fn child_distances2(node: &Node4, x: DVec3) -> [f64; 4] {
-    let mut d2 = [0.0f64; 4];
-    for (a, xa) in x.to_array().into_iter().enumerate() {
-        for (k, d2k) in d2.iter_mut().enumerate() {
-            let below = node.min[a][k] as f64 - xa;
-            let above = xa - node.max[a][k] as f64;
-            let d = if below > above { below } else { above };
-            let d = if d > 0.0 { d } else { 0.0 };
-            *d2k += d * d;
-        }
-    }
-    d2
-}
-
 /// The box of slot `k` of a wide node, in f64.
 #[inline]
 fn slot_box(node: &Node4, k: usize) -> (DVec3, DVec3) {
@@ -344,7 +327,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
                 continue;
             }
             let node = &wide[e.i as usize];
-            let d2 = child_distances2(node, self.x);
+            let d2 = node.distances2(self.x);
             let mut open = Open::new();
             for j in 0..2 {
                 self.middle(node, e.i, j, &d2, (reach2, budget2), &mut open);
