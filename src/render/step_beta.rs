@@ -19,26 +19,19 @@
 //! The rays of a tile meet the same part of the surface, so once a refinement in the
 //! tile finds a gap of at least `G_SWITCH` epsilons, the tile's later rays make their
 //! step evaluations at the hit beta: no refinement is needed then. Below that gap the
-//! coarse steps pay: on the lidar scan (gaps of a fraction of epsilon) steps at the hit
-//! beta everywhere visit 24% more leaves per ray (169.6 -> 210.7 at 960x540), on the
-//! deer at alpha 4 (gaps under one epsilon) 17% more. The hits of switched tiles sit
-//! where those of coarse steps sit once the hit is moved on by its free distance
-//! (`TracerOptions::final_step`): the exact value at the hits of the bunny's points
-//! (480x270, mean) is 0.274 epsilons with every tile's steps left coarse and 0.281 with
-//! the switch at 1 epsilon, where most of its tiles switch. (Without that step a switch
-//! left the hits higher in the band, 0.39 -> 0.54: the coarse steps' lag sent a ray one
-//! fine step deeper.) Every step is still a Barnes-Hut sum, a lower bound of the exact one, so every step stays
-//! safe, and hits are decided at `b_h` as before. Only the tile's own rays (same tile
-//! and sample pass) teach it, so a render does not depend on how tiles are spread over
-//! threads, and a crop traces its tiles as the whole image does. (Edges and triangles
-//! step at the scene's beta and decide hits at 0.6 of it, and refine in the same way;
-//! on the scenes of Table 1 their gaps stay below the switch, and they render as
-//! before.)
+//! coarse steps pay (the lidar scan's gaps are a fraction of epsilon, and steps at the
+//! hit beta everywhere would visit more leaves). Every step is still a Barnes-Hut sum, a
+//! lower bound of the exact one, so every step stays safe, and hits are decided at `b_h`
+//! as before. Only the tile's own rays (same tile and sample pass) teach it, so a render
+//! does not depend on how tiles are spread over threads, and a crop traces its tiles as
+//! the whole image does. (Edges and triangles step at the scene's beta and decide hits
+//! at 0.6 of it, and refine in the same way.) What the switch and its threshold bought,
+//! scene by scene: doc/performance-log.md, round eleven.
 
 /// A refinement that finds the step value this many epsilons below the hit beta's
-/// switches the tile's steps to the hit beta (bunny's points and deer at alpha 2,
-/// 960x540: 4.38 -> 3.05 and 4.96 -> 3.13 full evaluations per hit ray against a switch
-/// at 4 epsilons; the deer at alpha 4 and the lidar scan keep their coarse steps).
+/// switches the tile's steps to the hit beta (1 rather than 4: fewer full evaluations
+/// per hit ray on the bunny's points and the deer at alpha 2, while the deer at alpha 4
+/// and the lidar scan keep their coarse steps; round eleven of the performance log).
 const G_SWITCH: f64 = 1.0;
 
 /// What a tile's rays have learned about its step evaluations.

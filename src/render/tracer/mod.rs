@@ -143,8 +143,8 @@ pub struct RayResult {
 const PREDICT: f64 = 2.0;
 
 /// The same where the tile's steps are made at the hit beta (`render::step_beta`): the
-/// gradient is all such a prediction adds (deer at alpha 1, 960x540: 3.16 -> 2.97 full
-/// evaluations per hit ray, a third of its hits needed a second traversal before).
+/// gradient is all such a prediction adds, and fewer hits need a second traversal for
+/// their normal (measured in doc/performance-log.md, round eleven).
 const PREDICT_AT_HIT_BETA: f64 = 4.0;
 
 /// The tracer's pruning tolerance is `min(PRUNE_SHARE alpha epsilon, PRUNE_CAP)` (module
@@ -155,11 +155,9 @@ const PRUNE_CAP: f64 = 1e-2;
 /// The final step's longest reach, in units of the hit's value `s` (module docs, item
 /// 4): a ray that meets the surface at a slope of 1/2 or more (30 degrees) crosses it
 /// within `2 s`. The free distance may certify more, but on a ray that skims bumpy ground
-/// (the lidar scan's trees) a longer step carries the hit past its closest approach: the
-/// 99th percentile of the exact value at the lidar's hits (240x135, `ray_probe ...
-/// hitcheck`) is 1.01 epsilons without the final step, 0.96 / 1.00 / 1.45 with caps of
-/// 1 / 2 / 4 s, the largest 1.12 and 1.30 / 2.07 / 3.83, while the mean is 0.56 and
-/// 0.34 / 0.19 / 0.19.
+/// (the lidar scan's trees) a longer step carries the hit past its closest approach
+/// (the exact value at the hits for caps of 1, 2 and 4 `s`: doc/performance-log.md,
+/// round twelve).
 const FINAL_REACH: f64 = 2.0;
 
 /// Where the neighbours' balls (if any) carry a ray certified free up to `t`.
