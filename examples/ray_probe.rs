@@ -12,7 +12,8 @@
 //! `hitcheck` (every pixel's ray traced by tiles, as renders trace them; the exact
 //! value, beta 0, at each hit point in epsilons: how far the hits sit from the exact
 //! zero set, and the share outside the hit band). A last argument `fixed-step-beta`
-//! turns the tiles' learned step beta (`render::step_beta`) off.
+//! turns the tiles' learned step beta (`render::step_beta`) off. `betas`: at points of the
+//! exact surface, how far each beta's sum lies below the exact value, and its leaves.
 use glam::DVec3;
 use rayon::prelude::*;
 use smoothtrace::eval::evaluate_value;
@@ -74,6 +75,57 @@ fn main() {
                 }
                 println!("  s_BH/s_exact around the hit, steps of eps/2 (in eps): {line}");
             }
+        }
+        return;
+    }
+    if args.get(4).map(String::as_str) == Some("betas") {
+        // At points of the exact surface (an exact march, beta 0, on every ninth pixel
+        // of every ninth row), how far below the exact value each beta's sum lies, in
+        // epsilons, and its leaves: the far field's deficit (performance log, round
+        // fifteen). The tracer's pruning tolerance throughout.
+        let ev = |x: DVec3, beta: f64| {
+            let mut p = obj.params;
+            p.beta = beta;
+            p.prune_tolerance = (0.025 * p.alpha * eps).min(1e-2);
+            let r = evaluate_value(&sets, x, &p);
+            (r.s / eps, r.stats.leaves())
+        };
+        let betas = [0.0, 0.1, 0.3, 0.5, 1.0, 4.0];
+        let mut rows: Vec<Vec<(f64, u32)>> = Vec::new();
+        for py in (0..h).step_by(9) {
+            for px in (0..w).step_by(9) {
+                let (o, d) = cam.ray(px, py);
+                let mut t = 0.0;
+                let mut hit = false;
+                for _ in 0..5000 {
+                    let s = ev(o + t * d, 0.0).0 * eps;
+                    if s < eps {
+                        hit = true;
+                        break;
+                    }
+                    t += s;
+                    if t > tracer.farthest(o) {
+                        break;
+                    }
+                }
+                if hit {
+                    rows.push(betas.iter().map(|&b| ev(o + t * d, b)).collect());
+                }
+            }
+        }
+        println!(
+            "alpha {:.4} (alpha x epsilon {:.3}), {} exact hit points: median deficit below the exact value (epsilons) / mean leaves",
+            obj.params.alpha,
+            obj.params.alpha * eps,
+            rows.len()
+        );
+        for (k, b) in betas.iter().enumerate() {
+            let mut def: Vec<f64> = rows.iter().map(|r| r[0].0 - r[k].0).collect();
+            let leaves = rows.iter().map(|r| r[k].1 as f64).sum::<f64>() / rows.len().max(1) as f64;
+            println!(
+                "beta {b}: {:.2} / {leaves:.0}",
+                quantile(&mut def, 0.5).unwrap_or(f64::NAN)
+            );
         }
         return;
     }
