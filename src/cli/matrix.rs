@@ -50,6 +50,9 @@ pub struct MatrixArgs {
     /// Relative rise of a count that --check tolerates.
     #[arg(long, default_value_t = 0.03, requires = "matrix")]
     tolerance: f64,
+    /// Hits certified within one epsilon of the exact sum (`render --certified-hits`).
+    #[arg(long, requires = "matrix")]
+    certified_hits: bool,
 }
 
 /// The flags the matrix shares with Table 1's bench.
@@ -136,6 +139,7 @@ pub fn run(a: MatrixArgs, c: Common) -> Result<()> {
         beta: a.beta,
         error_size,
         repeat: c.repeat,
+        certified_hits: a.certified_hits,
     };
     let cells = matrix::cells(&opts)?;
     super::outputs::check_report_outputs(&c.csv, &c.json, None)?;

@@ -91,6 +91,11 @@ pub struct RenderArgs {
     /// step at the scene's beta).
     #[arg(long, default_value_t = 4.0)]
     coarse_beta: f64,
+    /// Edges and triangles: decide hits only where the value is certified within one
+    /// epsilon of the exact sum, refining the far field where it is not (soft fields over
+    /// dense meshes: the exact surface, at many times the cost there).
+    #[arg(long)]
+    certified_hits: bool,
     /// List what was built (meshes, primitive sets, BVHs, MatCaps) and its times, and
     /// print the render's counters (evaluations, bound steps, leaves per ray) after it.
     #[arg(short, long)]
@@ -284,8 +289,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
     // Every output is checked before the render (issue 10, defect 5).
     let outputs = check_outputs(&a, &film)?;
     film.keep_aovs = !outputs.aovs.is_empty();
-    let coarse_beta = a.coarse_beta;
-    let tracer_options = |o| TracerOptions { coarse_beta, ..o };
+    let (coarse_beta, certified_hits) = (a.coarse_beta, a.certified_hits);
+    let tracer_options = |o| TracerOptions {
+        coarse_beta,
+        certified_hits,
+        ..o
+    };
     let label = a.scene.display().to_string();
     let (built, rendered) = pipeline::in_pool(scene.render.threads, || -> Result<_> {
         let built = smoothtrace::render::build::build_scene(&scene)?;

@@ -35,6 +35,14 @@ pub struct Accumulator {
     /// Upper bound of the shifted mass of subtrees pruned against the budget (added to
     /// the sum at the end, so `s` stays a lower bound).
     pub pruned: f64,
+    /// When set, `lower` sums the terms that are exact and, for far-field terms (added
+    /// while `far_term` is set), the lower bound of their subtrees (`far_lower`),
+    /// shifted like `s`: `m - ln(lower) / alpha` bounds the exact value from above. (Kept
+    /// apart rather than as `s` minus the far terms: those can exceed the exact sum by
+    /// many orders of magnitude, and the difference would be rounding.)
+    pub track_far: bool,
+    pub far_term: bool,
+    lower: f64,
 }
 
 impl Accumulator {
@@ -48,6 +56,9 @@ impl Accumulator {
             naive_s: 0.0,
             naive_g: DVec3::ZERO,
             pruned: 0.0,
+            track_far: false,
+            far_term: false,
+            lower: 0.0,
         }
     }
 
@@ -61,6 +72,7 @@ impl Accumulator {
             self.s *= rescale;
             self.g *= rescale;
             self.pruned *= rescale;
+            self.lower *= rescale;
             self.m = d;
         }
     }
@@ -76,6 +88,9 @@ impl Accumulator {
         let gterm = w * dir - grad_w * inv_alpha;
         self.s += w * e;
         self.g += e * gterm;
+        if self.track_far && !self.far_term {
+            self.lower += w * e;
+        }
         if self.naive {
             let e = (-self.alpha * d).exp();
             self.naive_s += w * e;
@@ -91,6 +106,9 @@ impl Accumulator {
         self.shift(d);
         let e = w * (-self.alpha * (d - self.m)).exp();
         self.s += e;
+        if self.track_far && !self.far_term {
+            self.lower += e;
+        }
         if self.naive {
             self.naive_s += w * (-self.alpha * d).exp();
         }
@@ -98,6 +116,22 @@ impl Accumulator {
     }
 
     /// The sharpness the terms are summed at.
+    /// Records the lower bound `n exp(-alpha d_far)` of a far-field subtree.
+    #[inline]
+    pub fn far_lower(&mut self, n: f64, d_far: f64) {
+        self.lower += n * (-self.alpha * (d_far - self.m)).exp();
+    }
+
+    /// An upper bound of the exact smooth distance: far terms at their lower bounds,
+    /// pruned subtrees at zero.
+    pub fn upper(&self) -> f64 {
+        if self.lower > 0.0 {
+            self.m - self.lower.ln() / self.alpha
+        } else {
+            f64::INFINITY
+        }
+    }
+
     #[inline]
     pub fn alpha(&self) -> f64 {
         self.alpha

@@ -47,6 +47,9 @@ pub struct EvalParams {
     /// Far-field terms of point clouds from the subtree's second moments (module docs;
     /// default on). Off, every far-field term is the closest-box one (the paper's).
     pub moments: bool,
+    /// Also bound the exact value from above (`Sample::s_upper`; far-field subtrees at
+    /// their lower bounds): one more exponential per far-field term. Default off.
+    pub upper_bound: bool,
     /// Prune against a budget as well (module docs; default on, only with `prune` and
     /// the stable sum): the same tolerance, far fewer leaves.
     pub budget: bool,
@@ -62,6 +65,7 @@ impl EvalParams {
             prune: true,
             prune_tolerance: PRUNE_TOLERANCE,
             moments: true,
+            upper_bound: false,
             budget: true,
         }
     }

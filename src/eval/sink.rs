@@ -68,6 +68,8 @@ pub(crate) struct Sink<'a, const GRAD: bool, const SLOPE: bool> {
     pub acc: &'a mut Accumulator,
     pub slopes: &'a mut Slopes,
     pub u: DVec3,
+    /// Weight of a far-field term per primitive (for its lower bound).
+    pub w_ff: f64,
 }
 
 impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
@@ -105,6 +107,7 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
                 if d > 0.0 { v.dot(u) / d } else { -1.0 }
             })
         };
+        self.acc.far_term = true;
         if GRAD {
             let dir = (x - x.clamp(min, max)) / r;
             let e = self.acc.add(r, weight, dir, DVec3::ZERO);
@@ -117,6 +120,15 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
             self.add_slope(m, e, a.min(slope_other(self.u)));
         } else {
             self.acc.add_value(r, weight);
+        }
+        self.acc.far_term = false;
+        if self.acc.track_far {
+            // Every primitive below lies in the box (the union of a middle's two), within
+            // the distance of its farthest corner, with a weight of at least 1.
+            let (lo, hi) = other.map_or((min, max), |(a, b)| (min.min(a), max.max(b)));
+            let far_corner = DVec3::select((x - 0.5 * (lo + hi)).cmpge(DVec3::ZERO), lo, hi);
+            self.acc
+                .far_lower(weight / self.w_ff, (x - far_corner).length());
         }
     }
 

@@ -90,6 +90,11 @@ pub struct Sample {
     /// [`Along::back`] and `s` is below it (at most that length); `s` otherwise.
     pub reach_back: f64,
     pub stats: EvalStats,
+    /// With `EvalParams::upper_bound`, an upper bound of the exact smooth distance
+    /// (far-field terms at the lower bound of their subtrees, pruned ones at zero; the
+    /// second-moment terms of point clouds count as exact, so there it is an estimate);
+    /// `+inf` otherwise.
+    pub s_upper: f64,
 }
 
 /// Evaluates the smooth distance of the union of `sets` at `x`, with its gradient.
@@ -175,6 +180,7 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
 ) -> Sample {
     let u = along.u;
     let mut acc = Accumulator::new(p.alpha, p.accumulation);
+    acc.track_far = p.upper_bound;
     let mut slopes = Slopes::default();
     let mut stats = EvalStats::default();
     let scale = |s: &AnySet| WeightScale::new(s.max_adj(), p.alpha, p.max_alpha);
@@ -192,12 +198,18 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
                 acc: &mut acc,
                 slopes: &mut slopes,
                 u,
+                w_ff: sc.max_weight(),
             };
             crate::with_set!(set, s => {
                 Walk::new(s, x, p, &sc, prune_margin, budget, &mut sink, &mut stats, stack).run()
             });
         }
     });
+    let s_upper = if p.upper_bound {
+        acc.upper()
+    } else {
+        f64::INFINITY
+    };
     let kept = acc.shifted_sum();
     let pruned = if stats.pruned > 0 {
         // Subtrees pruned by the first rule hold less than the tolerance of the final
@@ -229,5 +241,6 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
         reach,
         reach_back,
         stats,
+        s_upper,
     }
 }

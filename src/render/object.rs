@@ -73,7 +73,7 @@ impl TraceObject {
     /// decisions a finer one) and the pruning tolerance possibly raised (a lower bound
     /// too, see `eval::smooth`), with the gradient if `grad`, and with the free distances
     /// along a ray if `along` is given (`eval::reach`); with closest-box
-    /// far fields if `bound` (a bound step).
+    /// far fields if `bound` (a bound step); with `Sample::s_upper` if `upper`.
     #[allow(clippy::too_many_arguments)]
     pub fn evaluate(
         &self,
@@ -85,8 +85,10 @@ impl TraceObject {
         grad: bool,
         along: Option<Along>,
         bound: bool,
+        upper: bool,
     ) -> Sample {
         let mut p = self.params;
+        p.upper_bound = upper;
         p.alpha = alpha;
         p.beta = beta;
         p.prune_tolerance = p.prune_tolerance.max(prune_tolerance);

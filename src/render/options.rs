@@ -55,6 +55,11 @@ pub struct TracerOptions {
     /// closer to it (tracer module docs, item 4). Off, the hit is the sample that came
     /// within epsilon (the paper's).
     pub final_step: bool,
+    /// Hits on edges and triangles are decided only where the value's certified gap
+    /// (how far the exact value may lie above it) is at most `GAP_MAX` epsilons, halving
+    /// the hit beta until it is (`render::tracer` item 11): the surface of the exact sum
+    /// at the price of fine evaluations where the far field is loose (soft fields).
+    pub certified_hits: bool,
 }
 
 /// How a step that overshoots into the negative band is resolved.
@@ -86,6 +91,7 @@ impl TracerOptions {
             clip: true,
             backtrack: Backtrack::Illinois,
             final_step: true,
+            certified_hits: false,
         }
     }
 

@@ -108,6 +108,8 @@ pub struct MatrixOptions {
     pub error_size: Option<(u32, u32)>,
     /// Renders per cell; the fastest is reported (counts are the same every time).
     pub repeat: usize,
+    /// Hits certified within one epsilon of the exact sum (`TracerOptions::certified_hits`).
+    pub certified_hits: bool,
 }
 
 /// A measured cell.
@@ -287,7 +289,10 @@ fn run_cell(
     let render = |built: &crate::render::build::BuiltScene, max_steps| {
         render_objects(
             &built.objects,
-            TracerOptions::new(built.epsilon, max_steps),
+            TracerOptions {
+                certified_hits: opts.certified_hits,
+                ..TracerOptions::new(built.epsilon, max_steps)
+            },
             &built.camera,
             &built.shaders,
             [0, 0, 0],
@@ -565,6 +570,7 @@ mod tests {
             height: 54,
             beta: 0.5,
             error_size: None,
+            certified_hits: false,
             repeat: 1,
         };
         let cells = cells(&opts).unwrap();

@@ -76,9 +76,22 @@
 //!     the hit band or below is taken again at the hit beta before it decides anything.
 //!     Where a refinement finds the step value one or more epsilons low (soft point
 //!     clouds), the tile's later rays step at the hit beta (`render::step_beta`).
+//! 11. With `TracerOptions::certified_hits` (`render --certified-hits`), on edges and
+//!     triangles a value that would decide (in the hit band or below) also says how far
+//!     the exact value may lie above it: the same walk sums each far-field subtree's
+//!     lower bound (`n exp(-alpha r_far)`, `r_far` the distance to the box's farthest
+//!     corner) beside its upper one, which bounds the exact smooth distance from above
+//!     (`eval::smooth`). Where that gap exceeds [`GAP_MAX`] epsilons (soft fields over
+//!     dense meshes, whose closest-box far field can be tens of epsilons low) the value
+//!     is taken again at half the hit beta, and again, up to [`MAX_HALVINGS`] times and
+//!     then exactly; the ray keeps the finer beta. Elsewhere the gap is a fraction of
+//!     epsilon and nothing changes. Off by default: where it acts, the ray walks the
+//!     last tens of epsilons with fine evaluations (doc/performance-log.md, round
+//!     fifteen).
 
 mod sample;
 
+use sample::MAX_HALVINGS;
 pub(super) use sample::{FieldSample, Want};
 
 use super::neighbours::Neighbours;
@@ -126,6 +139,10 @@ pub struct RayStats {
     /// Re-evaluations at the finer hit beta of a sample whose value at the scene's beta
     /// fell in the hit band or below (counted in `evals` too).
     pub refinements: u32,
+    /// Times the ray's hit beta was halved because a value in the hit band or below
+    /// had a certified gap above [`GAP_MAX`] epsilons (module docs, item 11; the
+    /// re-evaluations are counted in `evals` and `refinements` too).
+    pub hit_halvings: u32,
     /// The ray ran out of steps (counted as a miss).
     pub exhausted: bool,
 }
@@ -146,6 +163,11 @@ const PREDICT: f64 = 2.0;
 /// gradient is all such a prediction adds, and fewer hits need a second traversal for
 /// their normal (measured in doc/performance-log.md, round eleven).
 const PREDICT_AT_HIT_BETA: f64 = 4.0;
+
+/// A value in the hit band or below whose certified gap (how far the exact value may lie
+/// above it) exceeds this many epsilons is evaluated again at half the hit beta (module
+/// docs, item 11).
+const GAP_MAX: f64 = 1.0;
 
 /// The tracer's pruning tolerance is `min(PRUNE_SHARE alpha epsilon, PRUNE_CAP)` (module
 /// docs, item 6): values lower by at most `2 PRUNE_SHARE epsilon`.
@@ -463,6 +485,20 @@ impl<'a> Tracer<'a> {
                 if let Some(st) = steps.as_deref_mut() {
                     st.refined(coarse, f.s, eps);
                 }
+            }
+            // A value that would decide (a hit, or a crossing) whose exact value may lie
+            // more than GAP_MAX epsilons above it is taken again at half the hit beta
+            // (item 11).
+            while self.options.certified_hits
+                && self.sticky
+                && f.s <= eps
+                && f.gap > GAP_MAX * eps
+                && stats.hit_halvings <= MAX_HALVINGS
+            {
+                accurate = true;
+                stats.hit_halvings += 1;
+                stats.refinements += 1;
+                f = self.sample(x, &mut stats, Want::Gradient, true, along, step_beta);
             }
             near = f.s - gap < 2.0 * tau;
             if f.s.abs() <= eps {

@@ -13,6 +13,9 @@ use crate::eval::Along;
 use crate::render::step_beta::StepBeta;
 use glam::DVec3;
 
+/// Halvings of the hit beta after which a hit is decided by the exact sum.
+pub(super) const MAX_HALVINGS: u32 = 4;
+
 /// A sample of the scene field: its lower bound `s`, the object attaining it, and what
 /// was asked for besides.
 #[derive(Clone, Copy)]
@@ -25,6 +28,10 @@ pub(in crate::render) struct FieldSample {
     pub(super) reach: f64,
     /// Free distance back along the ray (`s` when not asked for, or not shorter).
     pub(super) reach_back: f64,
+    /// How far the winning object's exact value may lie above `s` (its certified upper
+    /// bound minus `s`, `eval::smooth`); 0 for objects whose hits keep the scene's beta
+    /// (point clouds), whose far terms the bound does not cover.
+    pub(super) gap: f64,
 }
 
 /// What an evaluation is for: a bound step at a coarser beta, or a full-accuracy value
@@ -58,6 +65,16 @@ impl<'a> Tracer<'a> {
         .s
     }
 
+    /// Object `k`'s hit beta after the ray halved it `halvings` times (a certified gap
+    /// above epsilon, `render::tracer` item 11); 0 (exact) past [`MAX_HALVINGS`].
+    pub(super) fn hit_beta_now(&self, k: usize, halvings: u32) -> f64 {
+        if halvings > MAX_HALVINGS {
+            0.0
+        } else {
+            self.hit_beta[k] * 0.5f64.powi(halvings as i32)
+        }
+    }
+
     /// The gradient of object `k`'s smooth distance at `x` (one evaluation, at the hit
     /// beta).
     pub fn gradient(&self, k: usize, x: DVec3, stats: &mut RayStats) -> DVec3 {
@@ -68,10 +85,11 @@ impl<'a> Tracer<'a> {
                 &self.sets[k],
                 x,
                 alpha,
-                self.hit_beta[k],
+                self.hit_beta_now(k, stats.hit_halvings),
                 self.tolerance[k],
                 true,
                 None,
+                false,
                 false,
             );
             stats.evals += 1;
@@ -100,6 +118,7 @@ impl<'a> Tracer<'a> {
             grad: None,
             reach: f64::INFINITY,
             reach_back: f64::INFINITY,
+            gap: 0.0,
         };
         // With several objects a step is the smallest value (no free distance).
         let along = along.filter(|_| self.objects.len() == 1 && !matches!(want, Want::Bound(_)));
@@ -116,7 +135,7 @@ impl<'a> Tracer<'a> {
             let evaluate = |alpha: f64, stats: &mut RayStats| {
                 let beta = match coarse {
                     Some(b) => b.max(obj.params.beta),
-                    None if accurate => self.hit_beta[k],
+                    None if accurate => self.hit_beta_now(k, stats.hit_halvings),
                     None => step_beta.beta(self.step_beta[k], self.hit_beta[k]),
                 };
                 let sample = obj.evaluate(
@@ -128,6 +147,7 @@ impl<'a> Tracer<'a> {
                     grad,
                     along,
                     coarse.is_some(),
+                    self.options.certified_hits && coarse.is_none(),
                 );
                 if coarse.is_some() {
                     stats.coarse_evals += 1;
@@ -163,6 +183,11 @@ impl<'a> Tracer<'a> {
                     grad: (grad && own_alpha).then_some(sample.grad),
                     reach: free(sample.reach),
                     reach_back: free(sample.reach_back),
+                    gap: if self.hit_beta[k] < obj.params.beta {
+                        (sample.s_upper - sample.s).max(0.0)
+                    } else {
+                        0.0
+                    },
                 };
             }
         }
