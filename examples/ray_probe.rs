@@ -381,6 +381,7 @@ fn main() {
                         false,
                         None,
                         false,
+                        false,
                     );
                     let st = e.stats;
                     sum[0] += st.exact as f64;
