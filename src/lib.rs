@@ -29,3 +29,4 @@ pub mod render;
 pub mod reports;
 pub mod scene;
 pub mod serve;
+pub mod winding;

@@ -36,6 +36,10 @@
 //! all others `+inf` (f32 `INFINITY`, also in the `.npy`); every linfac domain is cut to
 //! the band (exactly, row by row), and the BVH query is bounded by it.
 //!
+//! Signed volumes ([`sign::sign_field`], issue 32): the exact distance negated inside
+//! the solid (winding number above 1/2), the winding number evaluated only in blocks of
+//! voxels where the sign can change.
+//!
 //! [`DistanceField::sample`] interpolates trilinearly; [`DistanceField::lower_bound`]
 //! gives `d(x) >= d(v) - |x - v|` over the 8 surrounding voxel centres `v`, which a
 //! sphere tracer can use to skip empty space (SPEC 7).
@@ -48,6 +52,7 @@ mod grid;
 mod linfac;
 mod output;
 mod reference;
+pub mod sign;
 mod sites;
 mod volume;
 
