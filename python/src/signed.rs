@@ -1,13 +1,15 @@
 //! `winding_number` and `signed_distance`: a triangle soup's fast winding numbers and
 //! signed distances at many points (issue 32), through [`smoothtrace::api::signed`].
 
-use crate::arrays::{mesh, output};
+use crate::arrays::{output, rows};
 use crate::errors::{guard, to_py};
 use numpy::ndarray::{Ix1, Ix2};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
+use smoothtrace::api::arrays::mesh_from_arrays;
 use smoothtrace::api::params::check_threads;
 use smoothtrace::api::{InputError, signed, with_threads};
+use smoothtrace::mesh::Mesh;
 
 type Arr1<'py> = Bound<'py, PyArray1<f64>>;
 type Arr2<'py> = Bound<'py, PyArray2<f64>>;
@@ -16,6 +18,13 @@ type Arr2<'py> = Bound<'py, PyArray2<f64>>;
 fn threads(t: Option<i64>) -> PyResult<Option<usize>> {
     t.map(|t| check_threads("threads", t).map_err(to_py))
         .transpose()
+}
+
+/// The mesh `(V, F)`, errors naming `V` and `F` as the Python functions do.
+fn mesh(vertices: &PyReadonlyArray2<'_, f64>, faces: &PyReadonlyArray2<'_, i64>) -> PyResult<Mesh> {
+    let v = rows(vertices, "V", 3)?;
+    let f = rows(faces, "F", 3)?;
+    mesh_from_arrays(&v, &f, &[], ["V", "F", "edges"]).map_err(to_py)
 }
 
 /// The fast winding number of the triangles `(V, F)` at each row of `P`.
@@ -30,7 +39,7 @@ pub fn winding_number<'py>(
     threads: Option<i64>,
 ) -> PyResult<Arr1<'py>> {
     guard(|| {
-        let m = mesh(&vertices, Some(&faces), None)?;
+        let m = mesh(&vertices, &faces)?;
         let p = crate::arrays::points(&points, "P")?;
         let t = self::threads(threads)?;
         let w = py
@@ -58,7 +67,7 @@ pub fn signed_distance<'py>(
     threads: Option<i64>,
 ) -> PyResult<(Arr1<'py>, Bound<'py, PyArray1<i64>>, Arr2<'py>)> {
     guard(|| {
-        let m = mesh(&vertices, Some(&faces), None)?;
+        let m = mesh(&vertices, &faces)?;
         let p = crate::arrays::points(&points, "P")?;
         let t = self::threads(threads)?;
         let (s, near) = py
