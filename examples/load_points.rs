@@ -3,7 +3,7 @@
 //! shell: `/usr/bin/time -f %M cargo run --release --example load_points -- FILE`
 //! (better: run the built binary, `target/release/examples/load_points FILE`).
 
-use smoothtrace::las::load_mesh;
+use smoothtrace::load::load_with_origin as load_mesh;
 use smoothtrace::primitives::PrimitiveKind;
 use std::path::PathBuf;
 use std::time::Instant;

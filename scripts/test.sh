@@ -7,7 +7,8 @@
 # pytest on tests/python. trimesh (with rtree, scipy) is installed when the package index
 # provides it within two minutes; without it the comparison with trimesh skips and says
 # why. So is playwright (the browser test drives the system's Chromium with it; no
-# browser is downloaded). Exits non-zero if either suite fails.
+# browser is downloaded), and so are dask, distributed and zarr (the `[dask]` extra,
+# for smoothtrace.dask and reading the command line's .zarr volumes). Exits non-zero if either suite fails.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
@@ -23,6 +24,8 @@ if "$python" -m venv "$venv" && "$venv/bin/python" -m pip install --quiet --upgr
         echo "note: trimesh/rtree/scipy not installed; the trimesh comparison will skip"
     timeout 120 "$venv/bin/python" -m pip install --quiet playwright ||
         echo "note: playwright not installed; the browser test will skip"
+    timeout 180 "$venv/bin/python" -m pip install --quiet "dask[array,distributed]>=2023.1" "zarr>=2.16" ||
+        echo "note: dask/distributed/zarr not installed; the smoothtrace.dask tests will skip"
     SMOOTHTRACE_BIN="$PWD/target/release/smoothtrace" \
         "$venv/bin/python" -m pytest -p no:cacheprovider -rs tests/python
     py=$?

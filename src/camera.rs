@@ -20,6 +20,35 @@ const SAME_POINT_REL: f64 = 1e-12;
 /// Smallest accepted sine of the angle between `up` and the view direction.
 const PARALLEL_SIN: f64 = 1e-6;
 
+/// The settings of a pinhole camera (a scene's `[camera]`, SPEC 7), before the image
+/// size makes it a [`Camera`]. Scenes, auto-framing and the API all give one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraSettings {
+    pub origin: DVec3,
+    pub target: DVec3,
+    /// Default `[0, 1, 0]`.
+    pub up: DVec3,
+    /// Vertical field of view in degrees, in (0, 180). Default 53.13.
+    pub fov: f64,
+}
+
+impl CameraSettings {
+    /// A camera with the default up vector and field of view.
+    pub fn looking_at(origin: DVec3, target: DVec3) -> CameraSettings {
+        CameraSettings {
+            origin,
+            target,
+            up: DVec3::Y,
+            fov: Camera::DEFAULT_FOV_Y,
+        }
+    }
+
+    /// The camera for an image of this size.
+    pub fn build(&self, width: u32, height: u32) -> Result<Camera, CameraError> {
+        Camera::new(self.origin, self.target, self.up, self.fov, width, height)
+    }
+}
+
 /// Why a camera cannot be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CameraError {

@@ -1,14 +1,15 @@
 //! Auto-framing: a camera that shows the whole scene (issue 11, item 3).
 //!
 //! The scene's bounding sphere is taken around the centre of the objects' boxes, each
-//! box grown by how far its surface can reach ([`TraceObject::reach`], the quantity the
-//! tracer clips rays with, SPEC 7): radius = half the diagonal of that grown box. The
+//! box grown by how far its surface can reach (the quantity the tracer clips rays with,
+//! SPEC 7; the renderer passes the grown boxes in,
+//! `crate::render::TraceObject::reach_bounds`): radius = half the diagonal of their
+//! union. The
 //! camera looks at the centre from `direction` at the distance where the sphere fits
 //! both the vertical and the horizontal field of view with `margin` to spare
 //! (`distance = (1 + margin) radius / sin(half angle)`).
 
-use crate::render::TraceObject;
-use crate::scene::CameraSettings;
+use crate::camera::CameraSettings;
 use glam::DVec3;
 
 /// The default view direction (from the centre towards the camera): a three-quarter
@@ -29,17 +30,19 @@ pub struct Framing {
     pub margin: f64,
 }
 
-/// The box everything the surfaces can reach lies in (each object's box grown by its
-/// reach) as `(min, max)`; `None` without objects.
-pub fn reach_box(objects: &[TraceObject]) -> Option<(DVec3, DVec3)> {
+/// The box everything the surfaces can reach lies in, the union of the objects' boxes
+/// grown by their reach (`(min, max)` each); `None` without objects or when a bound is
+/// not finite.
+pub fn reach_box(grown: impl IntoIterator<Item = (DVec3, DVec3)>) -> Option<(DVec3, DVec3)> {
     let mut min = DVec3::splat(f64::INFINITY);
     let mut max = DVec3::splat(f64::NEG_INFINITY);
-    for o in objects {
-        let r = o.reach(o.params.alpha).max(0.0);
-        min = min.min(o.bounds.min.as_dvec3() - r);
-        max = max.max(o.bounds.max.as_dvec3() + r);
+    let mut any = false;
+    for (lo, hi) in grown {
+        any = true;
+        min = min.min(lo);
+        max = max.max(hi);
     }
-    (!objects.is_empty() && min.is_finite() && max.is_finite()).then_some((min, max))
+    (any && min.is_finite() && max.is_finite()).then_some((min, max))
 }
 
 /// The camera framing a sphere of `radius` around `centre` for an image of `aspect`
@@ -63,9 +66,14 @@ pub fn fit_sphere(centre: DVec3, radius: f64, aspect: f64, f: &Framing) -> Camer
     }
 }
 
-/// The camera framing `objects` (see the module docs); `None` without objects.
-pub fn fit_objects(objects: &[TraceObject], aspect: f64, f: &Framing) -> Option<CameraSettings> {
-    let (min, max) = reach_box(objects)?;
+/// The camera framing the objects whose grown boxes are `grown` (see the module docs);
+/// `None` without objects.
+pub fn fit_boxes(
+    grown: impl IntoIterator<Item = (DVec3, DVec3)>,
+    aspect: f64,
+    f: &Framing,
+) -> Option<CameraSettings> {
+    let (min, max) = reach_box(grown)?;
     Some(fit_sphere(
         0.5 * (min + max),
         0.5 * (max - min).length(),

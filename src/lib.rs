@@ -2,8 +2,9 @@
 //! clouds, edge meshes and triangle meshes. See `ARCHITECTURE.md` for the data flow and
 //! `SPEC.md` (shared) for the math.
 //!
-//! Data flows one way: [`mesh`] (files, [`procedural`] shapes) -> [`primitives`] (sets
-//! with valences and weights) -> [`bvh`] -> [`eval`] (smooth distance, nearest) ->
+//! Data flows one way: [`mesh`] and [`las`] files (read through [`load`]), [`procedural`]
+//! shapes -> [`bvh`] -> [`primitives`] (sets with valences, weights and their BVH) ->
+//! [`eval`] (smooth distance, nearest) ->
 //! [`render`] (tracer, image loop, with [`camera`] and [`matcap`]), configured by
 //! [`scene`] files. The [`reports`] (bench, sweep, stability) and the exact distance
 //! volumes of [`field`] (SPEC 9) call the same library; [`api`] serves callers that hold
@@ -16,10 +17,12 @@ pub mod colour;
 pub mod eval;
 pub mod field;
 pub mod film;
+pub mod font;
 pub mod framing;
 pub mod geometry;
 pub mod las;
 pub mod limits;
+pub mod load;
 pub mod matcap;
 pub mod mesh;
 pub mod output;
@@ -27,6 +30,7 @@ pub mod primitives;
 pub mod procedural;
 pub mod render;
 pub mod reports;
+pub mod rgb;
 pub mod scene;
 pub mod serve;
 pub mod winding;

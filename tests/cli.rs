@@ -217,11 +217,57 @@ fn render_writes_png_stats_and_depth() {
     let depth = image::open(d.path().join("depth.exr")).unwrap().to_rgb32f();
     let centre = depth.get_pixel(24, 16)[0];
     assert!(centre > 2.0 && centre < 4.0, "depth at the centre {centre}");
+    // One short line by default: scene, size, time, rays/s, output; no counters.
+    let e = stderr(&o);
+    let line = e.lines().last().unwrap_or_default();
     assert!(
-        stderr(&o).contains("evaluations/ray"),
-        "summary line: {}",
-        stderr(&o)
+        line.starts_with("s.toml: 48x32 in ")
+            && line.contains(" s, ")
+            && line.contains(" rays/s -> out.png")
+            && !line.contains("evaluations"),
+        "summary line: {e}"
     );
+    assert!(
+        line.len() < 100,
+        "summary line of {} characters: {line}",
+        line.len()
+    );
+}
+
+#[test]
+fn verbose_adds_the_counters_after_the_summary() {
+    let d = tempdir_with(&[("s.toml", SCENE)]);
+    let o = run(
+        &[
+            "render",
+            "s.toml",
+            "-o",
+            "out.png",
+            "--verbose",
+            "--threads",
+            "1",
+        ],
+        d.path(),
+        None,
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    let lines: Vec<&str> = e.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| l.contains(" rays/s -> out.png"))
+        .unwrap_or_else(|| panic!("no summary line: {e}"));
+    let counters = lines.get(at + 1).copied().unwrap_or_default();
+    for part in [
+        "1 threads",
+        "evaluations/ray",
+        "per hit ray",
+        "bound steps",
+        "leaves/ray",
+        "% hits",
+    ] {
+        assert!(counters.contains(part), "counters line lacks {part:?}: {e}");
+    }
 }
 
 #[test]

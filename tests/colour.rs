@@ -9,7 +9,7 @@
 mod common;
 
 use glam::DVec3;
-use smoothtrace::colour::{Colormap, SetColours, to_srgb8};
+use smoothtrace::colour::SetColours;
 use smoothtrace::eval::EvalParams;
 use smoothtrace::eval::colour::colour_at;
 use smoothtrace::mesh::Mesh;
@@ -17,6 +17,7 @@ use smoothtrace::primitives::{AnySet, PrimitiveKind};
 use smoothtrace::render::Hit;
 use smoothtrace::render::albedo::{shade_hit, tint};
 use smoothtrace::render::build::build_scene;
+use smoothtrace::rgb::{Colormap, to_srgb8};
 use smoothtrace::scene::Scene;
 use std::path::{Path, PathBuf};
 

@@ -316,7 +316,8 @@ fn auto_framing_shows_the_whole_scene_and_its_camera_pastes_back() {
     let span = rows.last().unwrap() - rows.first().unwrap();
     assert!(span > 30, "the scene spans {span} of 80 rows");
     // The camera centre looks at the reach box's centre.
-    let (min, max) = smoothtrace::framing::reach_box(&b.objects).unwrap();
+    let (min, max) =
+        smoothtrace::framing::reach_box(b.objects.iter().map(|o| o.reach_bounds())).unwrap();
     assert!((b.camera.target() - 0.5 * (min + max)).length() < 1e-9);
 }
 

@@ -713,7 +713,7 @@ fn fuzz_lidar(name: &str, ext: &str, muts: &[Mutation]) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join(format!("fuzzed.{ext}"));
     std::fs::write(&path, &bytes).unwrap();
-    check_outcome(&Mesh::load(&path), &path);
+    check_outcome(&smoothtrace::load::load_mesh(&path), &path);
 }
 
 #[test]

@@ -7,12 +7,13 @@ mod common;
 
 use common::data_file;
 use glam::DVec3;
-use smoothtrace::colour::{self, Colormap, SetColours, palette, srgb8_to_linear};
+use smoothtrace::colour::SetColours;
 use smoothtrace::eval::EvalParams;
 use smoothtrace::eval::colour::colour_at;
 use smoothtrace::las::{self, ColorBy, LasFilters, LasOptions, Returns, Thin};
 use smoothtrace::mesh::{Mesh, MeshError};
 use smoothtrace::primitives::{AnySet, PrimitiveKind};
+use smoothtrace::rgb::{self as colour, Colormap, palette, srgb8_to_linear};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
@@ -342,7 +343,7 @@ fn expect_file_error(path: &Path, name: &str) -> String {
     let m = e.to_string();
     assert!(m.contains(name), "error does not name {name}: {m}");
     // The mesh loader (query, field, scenes) gives the same error.
-    let m2 = Mesh::load(path).unwrap_err().to_string();
+    let m2 = smoothtrace::load::load_mesh(path).unwrap_err().to_string();
     assert!(m2.contains(name), "{m2}");
     m
 }
@@ -418,7 +419,7 @@ fn lidar_gives_points_only() {
         return;
     };
     for kind in [PrimitiveKind::Edges, PrimitiveKind::Triangles] {
-        let e = las::load_mesh(&laz, &[PrimitiveKind::Points, kind])
+        let e = smoothtrace::load::load_with_origin(&laz, &[PrimitiveKind::Points, kind])
             .unwrap_err()
             .to_string();
         assert!(
@@ -426,7 +427,8 @@ fn lidar_gives_points_only() {
             "{e}"
         );
     }
-    let (mesh, origin) = las::load_mesh(&laz, &[PrimitiveKind::Points]).unwrap();
+    let (mesh, origin) =
+        smoothtrace::load::load_with_origin(&laz, &[PrimitiveKind::Points]).unwrap();
     assert!(!mesh.vertices.is_empty() && origin.x > 6e5);
     // In a scene: the primitives key is named, with its line.
     let text = format!(

@@ -26,15 +26,29 @@ the same message as the ``smoothtrace`` command line; files that cannot be read 
 
 from __future__ import annotations
 
-import numbers
-import os
-from typing import Any, List, Mapping, Optional, Sequence, Tuple, Union
+import collections.abc as _abc
+import numbers as _numbers
+import os as _os
+import typing as _typing
 
-import numpy as np
+import numpy as _np
 
 from . import _native
 from ._native import __version__
 
+if _typing.TYPE_CHECKING:
+    # Names for the annotations only (they are not evaluated at run time, see the
+    # `__future__` import), so that the package's namespace holds its API alone.
+    import os
+    from typing import Any, List, Mapping, Optional, Sequence, Tuple, Union
+
+    import numpy as np
+
+# The `__future__` import above binds `annotations` in the module; the compiler flag is
+# all it is for.
+del annotations
+
+# The public API, one name a line; `dir(smoothtrace)` lists exactly these (see `__dir__`).
 __all__ = [
     "SmoothDistance",
     "distance_field",
@@ -46,38 +60,43 @@ __all__ = [
     "__version__",
 ]
 
+
+def __dir__() -> List[str]:
+    """The public API (``__all__``): what tab completion and ``dir(smoothtrace)`` show."""
+    return sorted(__all__)
+
 _KINDS = ("points", "edges", "triangles")
 
 
 def _coordinates(a: Any, name: str) -> np.ndarray:
     """`a` as a C-contiguous float64 array of shape (n, 3)."""
-    arr = np.asarray(a)
+    arr = _np.asarray(a)
     if arr.dtype.kind not in "fiu":
         raise ValueError(
             f"{name} must hold real numbers (a float or integer array), got dtype {arr.dtype}"
         )
     if arr.ndim != 2 or arr.shape[1] != 3:
         raise ValueError(f"{name} must have shape (n, 3), got {arr.shape}")
-    return np.ascontiguousarray(arr, dtype=np.float64)
+    return _np.ascontiguousarray(arr, dtype=_np.float64)
 
 
 def _indices(a: Any, name: str, width: int) -> Optional[np.ndarray]:
     """`a` as a C-contiguous int64 array of shape (n, width), or None."""
     if a is None:
         return None
-    arr = np.asarray(a)
+    arr = _np.asarray(a)
     if arr.size == 0 and arr.dtype.kind == "f":
         # An empty list becomes a float array; it holds no indices to misread.
-        arr = arr.astype(np.int64)
+        arr = arr.astype(_np.int64)
     if arr.dtype.kind not in "iu":
         raise ValueError(
             f"{name} must be an integer array of vertex indices, got dtype {arr.dtype}"
         )
     if arr.ndim != 2 or arr.shape[1] != width:
         raise ValueError(f"{name} must have shape (n, {width}), got {arr.shape}")
-    if arr.dtype.kind == "u" and arr.size and arr.max() > np.iinfo(np.int64).max:
+    if arr.dtype.kind == "u" and arr.size and arr.max() > _np.iinfo(_np.int64).max:
         raise ValueError(f"{name} holds vertex index {arr.max()}, out of range")
-    return np.ascontiguousarray(arr, dtype=np.int64)
+    return _np.ascontiguousarray(arr, dtype=_np.int64)
 
 
 def _primitives(
@@ -107,7 +126,7 @@ def _number(v: Any, name: str) -> Optional[float]:
     """A real number as float (None stays None); anything else is a ValueError."""
     if v is None:
         return None
-    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+    if isinstance(v, bool) or not isinstance(v, _numbers.Real):
         raise ValueError(f"{name} must be a number (got {v!r})")
     return float(v)
 
@@ -116,7 +135,7 @@ def _threads(threads: Any) -> Optional[int]:
     """A thread count as int (None: rayon's global pool); the range is checked in Rust."""
     if threads is None:
         return None
-    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
+    if isinstance(threads, bool) or not isinstance(threads, _numbers.Integral):
         raise ValueError(f"threads must be an integer (got {threads!r})")
     return int(threads)
 
@@ -331,6 +350,44 @@ def signed_distance(
     )
 
 
+def _field_args(
+    V, faces, edges, primitive, bounds, resolution, smooth_alpha, smooth_alpha_rel,
+    max_alpha, beta, method, band, threads,
+) -> tuple:
+    """The checked arguments of ``_native.distance_field`` and ``_native.FieldPlan``."""
+    kind = _primitives(primitive, faces, edges)
+    if len(kind) != 1:
+        raise ValueError(f"distance_field takes one primitive type (got {kind})")
+    if bounds is not None:
+        b = _np.asarray(bounds, dtype=_np.float64).reshape(-1)
+        if b.shape != (6,):
+            raise ValueError(
+                f"bounds must be [xmin, ymin, zmin, xmax, ymax, zmax] or [[min], [max]] (got {_np.shape(bounds)})"
+            )
+        bounds = [float(x) for x in b]
+    if isinstance(resolution, _numbers.Integral):
+        res = [int(resolution)]
+    else:
+        res = [int(r) for r in resolution]
+    if smooth_alpha is not None and smooth_alpha_rel is not None:
+        raise ValueError("give smooth_alpha or smooth_alpha_rel, not both")
+    return (
+        _coordinates(V, "V"),
+        _indices(faces, "faces", 3),
+        _indices(edges, "edges", 2),
+        kind[0],
+        bounds,
+        res,
+        str(method),
+        _number(smooth_alpha, "smooth_alpha"),
+        _number(smooth_alpha_rel, "smooth_alpha_rel"),
+        _number(max_alpha, "max_alpha"),
+        0.5 if beta is None else _number(beta, "beta"),
+        _number(band, "band"),
+        _threads(threads),
+    )
+
+
 def distance_field(
     V: Any,
     faces: Any = None,
@@ -376,39 +433,14 @@ def distance_field(
     return_bounds : bool
         Also return the grid's ``(2, 3)`` ``[min, max]`` corners.
     """
-    kind = _primitives(primitive, faces, edges)
-    if len(kind) != 1:
-        raise ValueError(f"distance_field takes one primitive type (got {kind})")
-    if bounds is not None:
-        b = np.asarray(bounds, dtype=np.float64).reshape(-1)
-        if b.shape != (6,):
-            raise ValueError(
-                f"bounds must be [xmin, ymin, zmin, xmax, ymax, zmax] or [[min], [max]] (got {np.shape(bounds)})"
-            )
-        bounds = [float(x) for x in b]
-    if isinstance(resolution, numbers.Integral):
-        res = [int(resolution)]
-    else:
-        res = [int(r) for r in resolution]
-    if smooth_alpha is not None and smooth_alpha_rel is not None:
-        raise ValueError("give smooth_alpha or smooth_alpha_rel, not both")
     field, lo, hi = _native.distance_field(
-        _coordinates(V, "V"),
-        _indices(faces, "faces", 3),
-        _indices(edges, "edges", 2),
-        kind[0],
-        bounds,
-        res,
-        str(method),
-        _number(smooth_alpha, "smooth_alpha"),
-        _number(smooth_alpha_rel, "smooth_alpha_rel"),
-        _number(max_alpha, "max_alpha"),
-        0.5 if beta is None else _number(beta, "beta"),
-        _number(band, "band"),
-        _threads(threads),
+        *_field_args(
+            V, faces, edges, primitive, bounds, resolution, smooth_alpha,
+            smooth_alpha_rel, max_alpha, beta, method, band, threads,
+        )
     )
     if return_bounds:
-        return field, np.array([lo, hi], dtype=np.float64)
+        return field, _np.array([lo, hi], dtype=_np.float64)
     return field
 
 
@@ -442,7 +474,7 @@ def _camera(camera: Any):
     """A camera dict as (origin, target, up, fov) for the extension, or None."""
     if camera is None:
         return None
-    if isinstance(camera, Mapping):
+    if isinstance(camera, _abc.Mapping):
         unknown = set(camera) - {"origin", "target", "up", "fov"}
         if unknown:
             raise ValueError(
@@ -462,7 +494,7 @@ def _camera(camera: Any):
         )
     vecs = []
     for name, v in zip(("origin", "target", "up"), parts[:3]):
-        a = np.asarray(v, dtype=np.float64).reshape(-1)
+        a = _np.asarray(v, dtype=_np.float64).reshape(-1)
         if a.shape != (3,):
             raise ValueError(f"camera {name} must be three numbers (got {v!r})")
         vecs.append([float(x) for x in a])

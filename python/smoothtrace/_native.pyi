@@ -59,6 +59,29 @@ def distance_field(
     band: Optional[float],
     threads: Optional[int],
 ) -> Tuple[F64, List[float], List[float]]: ...
+
+class FieldPlan:
+    """A field prepared once, computed box by box (`smoothtrace.dask`)."""
+
+    def __init__(
+        self,
+        vertices: F64,
+        faces: Optional[I64],
+        edges: Optional[I64],
+        primitive: str,
+        bounds: Optional[Sequence[float]],
+        resolution: List[int],
+        method: str,
+        smooth_alpha: Optional[float],
+        smooth_alpha_rel: Optional[float],
+        max_alpha: Optional[float],
+        beta: Optional[float],
+        band: Optional[float],
+        threads: Optional[int],
+    ) -> None: ...
+    def grid(self) -> Tuple[List[float], List[float], List[int]]: ...
+    def compute_box(self, start: Sequence[int], size: Sequence[int]) -> np.ndarray: ...
+
 def render(
     scene: str,
     width: Optional[int] = None,

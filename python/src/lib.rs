@@ -20,6 +20,7 @@ use pyo3::prelude::*;
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<smooth::SmoothDistance>()?;
+    m.add_class::<field::FieldPlan>()?;
     m.add_function(wrap_pyfunction!(mesh::load_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(field::distance_field, m)?)?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;

@@ -5,7 +5,6 @@ use crate::errors::{guard, to_py};
 use numpy::{PyArray2, ndarray::Ix2};
 use pyo3::prelude::*;
 use smoothtrace::api::arrays::{flat_indices, flat_vertices};
-use smoothtrace::mesh::Mesh;
 use std::path::PathBuf;
 
 type MeshArrays<'py> = (
@@ -18,7 +17,9 @@ type MeshArrays<'py> = (
 #[pyfunction]
 pub fn load_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<MeshArrays<'py>> {
     guard(|| {
-        let mesh = py.detach(|| Mesh::load(&path)).map_err(to_py)?;
+        let mesh = py
+            .detach(|| smoothtrace::load::load_mesh(&path))
+            .map_err(to_py)?;
         Ok((
             output::<_, Ix2>(py, (mesh.vertices.len(), 3), flat_vertices(&mesh.vertices))?,
             output::<_, Ix2>(py, (mesh.triangles.len(), 3), flat_indices(&mesh.triangles))?,

@@ -14,6 +14,7 @@
 //! centroid) are built without a copy of their boxes.
 
 use super::bins::{self, BINS, Binning, Bins, Item};
+use super::range::{Input, RangeBounds, range_bounds};
 use super::sweep::{SWEEP_MAX, half_area, sweep_split};
 use super::{Bvh, Node};
 use crate::mesh::Aabb;
@@ -39,55 +40,6 @@ const PARALLEL_MIN: usize = 16 * 1024;
 const PARALLEL_BINNING_MIN: usize = 256 * 1024;
 /// Chunk of items per parallel task in the passes over large ranges.
 const CHUNK: usize = 64 * 1024;
-
-pub(super) struct Input<'a> {
-    /// Primitive boxes by input index; `None` when every box is its centroid (points),
-    /// then binning reads the centroids only.
-    pub bounds: Option<&'a [Aabb]>,
-    pub leaf_size: usize,
-}
-
-impl Input<'_> {
-    #[inline]
-    pub fn bounds_of(&self, item: &Item) -> Aabb {
-        match self.bounds {
-            Some(b) => b[item.index as usize],
-            None => {
-                let c = Vec3::from_array(item.c);
-                Aabb { min: c, max: c }
-            }
-        }
-    }
-}
-
-/// Bounds of a range: of its primitives and of their centroids.
-#[derive(Clone, Copy)]
-pub(super) struct RangeBounds {
-    pub prims: Aabb,
-    pub centroids: Aabb,
-}
-
-impl RangeBounds {
-    pub const EMPTY: RangeBounds = RangeBounds {
-        prims: Aabb::EMPTY,
-        centroids: Aabb::EMPTY,
-    };
-
-    /// Grown by one primitive.
-    pub fn grow(self, input: &Input, it: &Item) -> RangeBounds {
-        RangeBounds {
-            prims: self.prims.union(input.bounds_of(it)),
-            centroids: self.centroids.grow(it.centroid()),
-        }
-    }
-
-    fn union(self, o: RangeBounds) -> RangeBounds {
-        RangeBounds {
-            prims: self.prims.union(o.prims),
-            centroids: self.centroids.union(o.centroids),
-        }
-    }
-}
 
 /// Builds a BVH over primitives given their bounds and centroids, with its wide form.
 pub fn build(bounds: &[Aabb], centroids: &[Vec3], options: BuildOptions) -> Bvh {
@@ -185,13 +137,6 @@ fn build_records(
         .reduce(|| RangeBounds::EMPTY, RangeBounds::union);
     let built = build_range(&input, &mut items, 0, rb);
     (built.flatten(), items)
-}
-
-/// Bounds of the primitives and of the centroids of `items`.
-pub(super) fn range_bounds(input: &Input, items: &[Item]) -> RangeBounds {
-    items
-        .iter()
-        .fold(RangeBounds::EMPTY, |acc, it| acc.grow(input, it))
 }
 
 /// A subtree as built in parallel: serial pieces (child indices relative to the piece's

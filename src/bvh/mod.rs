@@ -9,6 +9,7 @@
 mod bins;
 mod build;
 pub mod moments;
+mod range;
 mod sweep;
 mod validate;
 pub mod wide;

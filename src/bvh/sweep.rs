@@ -8,7 +8,7 @@
 //! axis instead of the best bin boundary.
 
 use super::bins::Item;
-use super::build::{Input, RangeBounds, range_bounds};
+use super::range::{Input, RangeBounds, range_bounds};
 use crate::mesh::Aabb;
 
 /// Ranges up to this size are split by the sweep.

@@ -48,9 +48,13 @@ pub struct BenchArgs {
     /// Write the table as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
+    /// The speed matrix instead of Table 1 (issue 30): meshes x primitive kinds x alpha *
+    /// diagonal x far/close views, auto-framed, 480x270 by default (`reports::matrix`).
+    #[command(flatten)]
+    matrix: super::matrix::MatrixArgs,
 }
 
-fn size(name: &str, v: i64) -> Result<u32> {
+pub(super) fn size(name: &str, v: i64) -> Result<u32> {
     let max = smoothtrace::scene::MAX_IMAGE_SIZE as i64;
     if !(1..=max).contains(&v) {
         bail!("--{name} must be in 1..={max} (got {v})");
@@ -75,6 +79,25 @@ pub fn parse_size(text: &str) -> Result<(u32, u32)> {
 }
 
 pub fn run(a: BenchArgs) -> Result<()> {
+    if a.matrix.matrix {
+        let (w, h) = (a.width.unwrap_or(480), a.height.unwrap_or(270));
+        let (w, h) = (size("width", w)?, size("height", h)?);
+        if !(0..=1024).contains(&a.threads) {
+            bail!("--threads must be in 0..=1024 (got {})", a.threads);
+        }
+        if !(1..=20).contains(&a.repeat) {
+            bail!("--repeat must be in 1..=20 (got {})", a.repeat);
+        }
+        let common = super::matrix::Common {
+            width: w,
+            height: h,
+            threads: a.threads as usize,
+            repeat: a.repeat as usize,
+            csv: a.csv,
+            json: a.json,
+        };
+        return super::matrix::run(a.matrix, common);
+    }
     let (dw, dh) = if a.quick { (240, 135) } else { (1920, 1080) };
     let width = size("width", a.width.unwrap_or(dw))?;
     let height = size("height", a.height.unwrap_or(dh))?;

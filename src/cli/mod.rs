@@ -5,6 +5,7 @@
 mod bench;
 pub(crate) mod console;
 mod field;
+mod matrix;
 mod outputs;
 mod progress;
 mod query;

@@ -67,7 +67,7 @@ pub fn run(a: QueryArgs) -> Result<()> {
     // Before any work: a closed standard output fails here.
     let mut out = Stdout::open()?;
     // Lidar coordinates are recentred on load; query points stay in file coordinates.
-    let (mesh, origin) = smoothtrace::las::load_mesh(&a.mesh, &a.primitive)?;
+    let (mesh, origin) = smoothtrace::load::load_with_origin(&a.mesh, &a.primitive)?;
     let mut sets = Vec::new();
     for &kind in &a.primitive {
         if !sets.iter().any(|s: &AnySet| s.kind() == kind) {

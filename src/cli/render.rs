@@ -1,5 +1,6 @@
-//! `smoothtrace render`: a scene file to a PNG, with a progress bar, a one-line summary,
-//! and optional statistics (JSON) and AOV outputs; anti-aliasing, transparency, crops
+//! `smoothtrace render`: a scene file to a PNG, with a progress bar, a one-line summary
+//! (scene, size, time, rays/s, output; the counters with `--verbose`), and optional
+//! statistics (JSON) and AOV outputs; anti-aliasing, transparency, crops
 //! (`--crop`, assembled by `stitch`) and turntables (`--turntable`, `--frames`, `--gif`).
 
 use super::console::note;
@@ -90,7 +91,8 @@ pub struct RenderArgs {
     /// step at the scene's beta).
     #[arg(long, default_value_t = 4.0)]
     coarse_beta: f64,
-    /// List what was built (meshes, primitive sets, BVHs, MatCaps) and its times.
+    /// List what was built (meshes, primitive sets, BVHs, MatCaps) and its times, and
+    /// print the render's counters (evaluations, bound steps, leaves per ray) after it.
     #[arg(short, long)]
     verbose: bool,
 }
@@ -377,7 +379,12 @@ pub fn run(a: RenderArgs) -> Result<()> {
         None => a.output.clone(),
     };
     match stats.as_slice() {
-        [st] => note!("{}", summary(&a.scene, st, &shown)),
+        [st] => {
+            note!("{}", summary(&a.scene, st, &shown));
+            if a.verbose {
+                note!("{}", counters(st));
+            }
+        }
         all => {
             let seconds: f64 = all.iter().map(|s| s.seconds).sum();
             let rays: u64 = all.iter().map(|s| s.rays).sum();
@@ -514,16 +521,27 @@ fn write_aov(kind: AovKind, out: &Output, r: &Rendered, objects: usize) -> Resul
     Ok(())
 }
 
-/// The one-line summary printed after a render.
+/// The one-line summary printed after every render: scene, size, time, rays per second
+/// and where the image went. The counters are [`counters`] (`--verbose`) and `--stats`.
 pub fn summary(scene: &Path, st: &ImageStats, output: &Path) -> String {
     format!(
-        "{}: {}x{} in {:.3} s on {} threads ({:.0} rays/s, {:.2} rays/pixel{}), {:.2} evaluations/ray ({:.2} per hit ray, max {}) + {:.2} bound steps ({:.2} per hit ray + {:.2} per ray on tiles), {:.1} leaves/evaluation, {:.0} leaves/ray, {:.1}% hits -> {}",
+        "{}: {}x{} in {:.3} s, {:.0} rays/s -> {}",
         scene.display(),
         st.width,
         st.height,
         st.seconds,
-        st.threads,
         st.rays_per_second(),
+        output.display()
+    )
+}
+
+/// The render's counters, one line (`--verbose`; `--stats` writes all of them as JSON):
+/// threads, rays per pixel, full evaluations and bound steps per ray and per hit ray,
+/// leaves per evaluation and per ray, and the share of rays that hit.
+pub fn counters(st: &ImageStats) -> String {
+    format!(
+        "{} threads, {:.2} rays/pixel{}; {:.2} evaluations/ray ({:.2} per hit ray, max {}) + {:.2} bound steps ({:.2} per hit ray + {:.2} per ray on tiles), {:.1} leaves/evaluation, {:.0} leaves/ray, {:.1}% hits",
+        st.threads,
         st.samples_per_pixel(),
         aa_note(st),
         st.evals_per_ray(),
@@ -535,7 +553,6 @@ pub fn summary(scene: &Path, st: &ImageStats, output: &Path) -> String {
         st.leaves_per_eval(),
         st.leaves_per_ray(),
         100.0 * st.hits as f64 / st.rays.max(1) as f64,
-        output.display()
     )
 }
 

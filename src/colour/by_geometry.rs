@@ -13,8 +13,8 @@
 //!
 //! The lidar attributes (`rgb`, `intensity`, ...) are `crate::las::ColorBy`.
 
-use super::{Colormap, Linear};
 use crate::mesh::Mesh;
+use crate::rgb::{Colormap, Linear};
 
 /// Which geometric quantity colours an object.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

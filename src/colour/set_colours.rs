@@ -4,9 +4,9 @@
 //!
 //! Built only when an object is coloured; the geometry's own arrays are not touched.
 
-use super::Linear;
 use crate::mesh::Mesh;
 use crate::primitives::{AnySet, PrimitiveKind};
+use crate::rgb::Linear;
 
 /// Colours of one primitive set.
 #[derive(Clone, Debug, Default)]

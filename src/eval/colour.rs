@@ -29,7 +29,7 @@ pub fn colour_at(
     p: &EvalParams,
 ) -> Option<Linear> {
     let scale = |s: &AnySet| WeightScale::new(s.max_adj(), p.alpha, p.max_alpha);
-    let prune_margin = super::smooth::prune_margin(sets, p, COLOUR_TOLERANCE);
+    let prune_margin = super::params::prune_margin(sets, p, COLOUR_TOLERANCE);
     let mut acc = Blend::new(p.alpha);
     for (set, cols) in sets.iter().zip(colours) {
         let sc = scale(set);

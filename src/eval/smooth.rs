@@ -19,13 +19,11 @@
 //!   `S` when `m` moves and added to the sum at the end, so it stays below `tol2` of the
 //!   final sum. The union bound of the first rule charges each subtree for all `N`
 //!   primitives; the budget charges what was actually skipped, so it skips whole
-//!   subtrees much nearer (the lidar scan: 377 -> 269 leaves per ray; 183.7 -> 168.4 at
-//!   1920x1080 with eighths instead of powers of two). Far fields are decided first: a
-//!   far term costs no more than the charge, and the budget is kept for subtrees that
-//!   would be opened. The union bound leaves most of its share unspent (its subtrees
-//!   are far), the budget spends what it charges: moving three quarters of the first
-//!   rule's share to the budget, the lidar at 960x540 visits 177.7 -> 169.6 leaves per
-//!   ray (the deer and the meshes 0-2% fewer).
+//!   subtrees much nearer. Far fields are decided first: a far term costs no more than
+//!   the charge, and the budget is kept for subtrees that would be opened. The union
+//!   bound leaves most of its share unspent (its subtrees are far), the budget spends
+//!   what it charges, so the budget takes three quarters of the tolerance. (What each
+//!   of these choices saved, scene by scene: `doc/performance-log.md`.)
 //!
 //!   Together (`tol1 + tol2 <= 2 tol`), `s` stays a lower bound of the exact value and
 //!   within `2 tol / alpha` of it. The nearest primitive is never pruned by the first
@@ -53,9 +51,10 @@
 //! at the opening distances) it is the term, with direction `u`; along a ray `x + t d`
 //! it is `n w F exp(-alpha (|x - c| + t u . d))` for the same `u`, an upper bound at
 //! every `t` with the exact slope `u . d` (what `eval::reach` needs). A middle (pair of
-//! slots) that is far field adds its two slots' terms. Same nodes visited; `s` several
-//! times closer to the exact value on soft clouds (`ln F` is about `alpha^2 sigma^2 / 2`
-//! against `alpha diam` for the box).
+//! slots) that is far field adds its two slots' terms. Same nodes visited; `s` closer to
+//! the exact value on soft clouds (`ln F` is about `alpha^2 sigma^2 / 2` against
+//! `alpha diam` for the box). The terms live in `eval::sink`, the walk in `eval::walk`,
+//! the parameters and tolerances in `eval::params`.
 //!
 //! The walk runs on the BVH's 4-wide form (`bvh::wide`): opening a wide node tests the
 //! four grandchildren of a binary node at once and makes the decisions above for the
@@ -65,98 +64,12 @@
 //! opened; the rest is pushed farthest first, so leaves are still met near to far.
 
 use super::accumulate::{Accumulation, Accumulator};
+use super::params::{EvalParams, EvalStats, prune_margin, rule_tolerances};
 use super::reach::Slopes;
+use super::sink::Sink;
 use super::walk::{STACK, Walk};
-use crate::primitives::{AnySet, Primitive, WeightScale};
+use crate::primitives::{AnySet, WeightScale};
 use glam::DVec3;
-
-/// Relative size of the sum that pruned subtrees may add up to at most, by default
-/// (queries, reports, the Python API): `s` is then within `2e-10 / alpha` of the exact
-/// value. The tracer passes a larger one tied to its hit threshold (see
-/// `render::tracer`): for a step or a hit test only `s` to a small share of epsilon
-/// matters, and pruning more is what makes soft point clouds cheaper.
-pub const PRUNE_TOLERANCE: f64 = 1e-10;
-
-/// Share of the tolerance the first pruning rule takes when a budget is kept; the budget
-/// takes the rest of `2 tol` (module docs).
-const FIRST_RULE_SHARE: f64 = 0.25;
-
-/// The tolerances of the first pruning rule and of the budget (0: no budget), whose sum
-/// bounds the share of the sum that pruning may skip (module docs).
-fn rule_tolerances(p: &EvalParams) -> (f64, f64) {
-    let tol = p.prune_tolerance;
-    if p.budget && p.prune && p.accumulation == Accumulation::Stable {
-        (FIRST_RULE_SHARE * tol, (2.0 - FIRST_RULE_SHARE) * tol)
-    } else {
-        (tol, 0.0)
-    }
-}
-
-/// Parameters of one smooth-distance evaluation.
-#[derive(Clone, Copy, Debug)]
-pub struct EvalParams {
-    /// Sharpness (1/length).
-    pub alpha: f64,
-    /// Weights are attenuated by `q = min(alpha / max_alpha, 1)` (SPEC 5).
-    pub max_alpha: f64,
-    /// Barnes-Hut opening parameter in [0, 1]; 0 sums every term exactly.
-    pub beta: f64,
-    pub accumulation: Accumulation,
-    /// Skip subtrees whose contribution is below `prune_tolerance` (default on).
-    pub prune: bool,
-    /// Share of the sum the pruned subtrees may hold together, in (0, 0.5]
-    /// (`PRUNE_TOLERANCE` by default); `s` stays a lower bound of the exact value and
-    /// within `2 prune_tolerance / alpha` of it.
-    pub prune_tolerance: f64,
-    /// Far-field terms of point clouds from the subtree's second moments (module docs;
-    /// default on). Off, every far-field term is the closest-box one (the paper's).
-    pub moments: bool,
-    /// Prune against a budget as well (module docs; default on, only with `prune` and
-    /// the stable sum): the same tolerance, far fewer leaves.
-    pub budget: bool,
-}
-
-impl EvalParams {
-    pub fn new(alpha: f64, max_alpha: f64, beta: f64) -> Self {
-        EvalParams {
-            alpha,
-            max_alpha,
-            beta,
-            accumulation: Accumulation::Stable,
-            prune: true,
-            prune_tolerance: PRUNE_TOLERANCE,
-            moments: true,
-            budget: true,
-        }
-    }
-}
-
-/// Work done by one evaluation.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct EvalStats {
-    /// Exact primitive terms.
-    pub exact: u32,
-    /// Far-field (approximated subtree) terms.
-    pub far: u32,
-    /// Nodes popped from the traversal stack.
-    pub nodes: u32,
-    /// Subtrees skipped as negligible.
-    pub pruned: u32,
-}
-
-impl EvalStats {
-    /// "Leaves visited": exact plus far-field terms (the paper's cost measure).
-    pub fn leaves(&self) -> u32 {
-        self.exact + self.far
-    }
-
-    pub fn add(&mut self, o: &EvalStats) {
-        self.exact += o.exact;
-        self.far += o.far;
-        self.nodes += o.nodes;
-        self.pruned += o.pruned;
-    }
-}
 
 /// Result of one evaluation.
 #[derive(Clone, Copy, Debug)]
@@ -177,61 +90,6 @@ pub struct Sample {
     /// [`Along::back`] and `s` is below it (at most that length); `s` otherwise.
     pub reach_back: f64,
     pub stats: EvalStats,
-}
-
-/// `g(z) = (e^z - 1 - z) / z^2` for `z >= 0`, from above (to a relative 1e-11): its
-/// Taylor series `sum z^k / (k + 2)!` to `k = 9` (remainder below `z^10 / 12!`) under
-/// 0.5, else from `exp` (no cancellation there), `+inf` past 700.
-#[inline]
-pub(crate) fn bennett_g(z: f64) -> f64 {
-    if z < 0.5 {
-        const C: [f64; 10] = [
-            1.0 / 2.0,
-            1.0 / 6.0,
-            1.0 / 24.0,
-            1.0 / 120.0,
-            1.0 / 720.0,
-            1.0 / 5040.0,
-            1.0 / 40320.0,
-            1.0 / 362880.0,
-            1.0 / 3628800.0,
-            1.0 / 39916800.0,
-        ];
-        C.iter().rev().fold(0.0, |acc, &c| acc * z + c) + 1e-11
-    } else if z < 700.0 {
-        (z.exp() - 1.0 - z) / (z * z)
-    } else {
-        f64::INFINITY
-    }
-}
-
-/// Grid step of [`bennett_g_chord`]'s table, and the grid's end.
-const G_STEP: f64 = 0.25;
-const G_END: f64 = 32.0;
-const G_POINTS: usize = (G_END / G_STEP) as usize + 1;
-
-/// `bennett_g` at the grid points `k G_STEP`, rounded up.
-static G_TABLE: std::sync::LazyLock<[f64; G_POINTS]> = std::sync::LazyLock::new(|| {
-    std::array::from_fn(|k| bennett_g(k as f64 * G_STEP) * (1.0 + 1e-12))
-});
-
-/// An upper bound of `g(z)` for `z >= 0` that costs no exponential: `g` is convex (its
-/// Taylor coefficients are positive), so on each grid interval the chord through its
-/// ends lies above it (by at most 0.7%: `e^z` over a quarter bends that much); past the
-/// grid, `bennett_g` itself (both rounded up by a relative 1e-12, above the rounding of
-/// `exp`). Saves the far-field terms of point clouds one exponential each (deer alpha 1
-/// trace 3-5% faster).
-#[inline]
-pub(crate) fn bennett_g_chord(z: f64) -> f64 {
-    if z < G_END {
-        let table = &*G_TABLE;
-        let u = z.max(0.0) * (1.0 / G_STEP);
-        let k = (u as usize).min(G_POINTS - 2);
-        let (lo, hi) = (table[k], table[k + 1]);
-        lo + (hi - lo) * (u - k as f64)
-    } else {
-        bennett_g(z) * (1.0 + 1e-12)
-    }
 }
 
 /// Evaluates the smooth distance of the union of `sets` at `x`, with its gradient.
@@ -309,19 +167,6 @@ pub fn evaluate_along(
     }
 }
 
-/// `ln(N w_max / tol) / alpha` for the `N` primitives of `sets` and their largest
-/// weight: a subtree farther than `m + margin - ln(S) / alpha` (module docs) holds less
-/// than `tol S / N` per primitive, so all such subtrees together hold less than `tol` of
-/// the sum. Shared with the colour traversal (`eval::colour`).
-pub(crate) fn prune_margin(sets: &[&AnySet], p: &EvalParams, tol: f64) -> f64 {
-    let total: usize = sets.iter().map(|s| s.len()).sum();
-    let w_max = sets
-        .iter()
-        .map(|s| WeightScale::new(s.max_adj(), p.alpha, p.max_alpha).max_weight())
-        .fold(1.0, f64::max);
-    (total.max(1) as f64 * w_max / tol).ln() / p.alpha
-}
-
 fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
     sets: &[&AnySet],
     x: DVec3,
@@ -384,176 +229,5 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
         reach,
         reach_back,
         stats,
-    }
-}
-
-/// Where a traversal's terms go: the accumulator, with the gradient if `GRAD`, and the
-/// terms' slopes along `u`, binned for the free distance, if `SLOPE` (`eval::reach`).
-pub(super) struct Sink<'a, const GRAD: bool, const SLOPE: bool> {
-    pub acc: &'a mut Accumulator,
-    pub slopes: &'a mut Slopes,
-    pub u: DVec3,
-}
-
-impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
-    /// The slope bins follow the accumulator's shift when a term lowers it.
-    #[inline]
-    fn add_slope(&mut self, m_before: f64, e: f64, a: f64) {
-        if self.acc.m < m_before {
-            let alpha = self.acc.alpha();
-            self.slopes
-                .rescale((-alpha * (m_before - self.acc.m)).exp());
-        }
-        self.slopes.add(e, a);
-    }
-
-    /// The far-field term of a subtree with box `min..max` at squared distance `r2 > 0`.
-    /// A middle (`other` = its farther child's box, the term at the nearer one's
-    /// distance) takes the smaller of the two boxes' slopes along the ray: each child's
-    /// distance is at least its own box's linear bound, and the nearer box's distance at
-    /// the sample is the smaller, so that line bounds both ahead (`eval::reach`).
-    #[inline]
-    pub fn far(
-        &mut self,
-        x: DVec3,
-        r2: f64,
-        weight: f64,
-        (min, max): (DVec3, DVec3),
-        other: Option<(DVec3, DVec3)>,
-    ) {
-        let r = r2.sqrt();
-        let m = self.acc.m;
-        let slope_other = |u: DVec3| {
-            other.map_or(1.0, |(lo, hi)| {
-                let v = x - x.clamp(lo, hi);
-                let d = v.length();
-                if d > 0.0 { v.dot(u) / d } else { -1.0 }
-            })
-        };
-        if GRAD {
-            let dir = (x - x.clamp(min, max)) / r;
-            let e = self.acc.add(r, weight, dir, DVec3::ZERO);
-            if SLOPE {
-                self.add_slope(m, e, dir.dot(self.u).min(slope_other(self.u)));
-            }
-        } else if SLOPE {
-            let a = (x - x.clamp(min, max)).dot(self.u) / r;
-            let e = self.acc.add_value(r, weight);
-            self.add_slope(m, e, a.min(slope_other(self.u)));
-        } else {
-            self.acc.add_value(r, weight);
-        }
-    }
-
-    /// The far-field term of a subtree of `n` points of weight at most `w` (`weight =
-    /// n w`) in the box `bx` at squared distance `r2 > 0` from `x` (closest-box term in
-    /// `near`: its squared distance, box and, for a middle, the farther child's box),
-    /// from their second moment about the
-    /// reference point `c` (`sigma2(u) >= u^T M u`) whose distance to their mean is at
-    /// most `lin` (module docs): the moment bound where it is below the box term.
-    #[allow(clippy::too_many_arguments)]
-    #[inline]
-    pub fn far_moments(
-        &mut self,
-        x: DVec3,
-        weight: f64,
-        bx: (DVec3, DVec3),
-        c: DVec3,
-        sigma2: impl Fn(DVec3) -> f64,
-        lin: f64,
-        (r2, near, other): (f64, (DVec3, DVec3), Option<(DVec3, DVec3)>),
-    ) {
-        let v = x - c;
-        let l2 = v.length_squared();
-        if l2 > 0.0 {
-            let alpha = self.acc.alpha();
-            let l = l2.sqrt();
-            let u = v * (1.0 / l);
-            // The largest u . (q - c) over the box bounds every point's.
-            let far_corner = DVec3::select(u.cmpge(DVec3::ZERO), bx.1, bx.0);
-            let z = alpha * u.dot(far_corner - c).max(0.0);
-            let f = (1.0 + alpha * lin + alpha * alpha * sigma2(u).max(0.0) * bennett_g_chord(z))
-                * (1.0 + 1e-9);
-            // ln f <= f - 1: where `f - 1 <= alpha (l - r)` the moment term is the smaller.
-            let reach = l - (f - 1.0) / alpha;
-            if reach >= 0.0 && reach * reach >= r2 {
-                self.term(l, weight * f, u);
-                return;
-            }
-        }
-        self.far(x, r2, weight, near, other);
-    }
-
-    /// A far-field term at distance `d` with unit direction `dir` (the gradient of `d`,
-    /// and its slope along the ray is `dir . u` exactly).
-    #[inline]
-    fn term(&mut self, d: f64, weight: f64, dir: DVec3) {
-        let m = self.acc.m;
-        if GRAD {
-            let e = self.acc.add(d, weight, dir, DVec3::ZERO);
-            if SLOPE {
-                self.add_slope(m, e, dir.dot(self.u));
-            }
-        } else if SLOPE {
-            let e = self.acc.add_value(d, weight);
-            self.add_slope(m, e, dir.dot(self.u));
-        } else {
-            self.acc.add_value(d, weight);
-        }
-    }
-
-    /// A primitive's exact term.
-    #[inline]
-    pub fn exact<P: Primitive>(&mut self, prim: &P, x: DVec3, scale: &WeightScale) {
-        let m = self.acc.m;
-        if GRAD {
-            let t = prim.term(x, scale);
-            let e = self.acc.add(t.d, t.w, t.dir, t.grad_w);
-            if SLOPE {
-                self.add_slope(m, e, t.dir.dot(self.u));
-            }
-        } else if SLOPE {
-            let (d, w, a) = prim.value_slope(x, self.u, scale);
-            let e = self.acc.add_value(d, w);
-            self.add_slope(m, e, a);
-        } else {
-            let (d, w) = prim.value(x, scale);
-            self.acc.add_value(d, w);
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `g(z)` in long arithmetic: its series to convergence (all terms positive).
-    fn g_series(z: f64) -> f64 {
-        let (mut term, mut sum, mut k) = (0.5f64, 0.0f64, 0.0f64);
-        while term > 1e-18 * sum.max(1e-300) || k < 3.0 {
-            sum += term;
-            k += 1.0;
-            term *= z / (k + 2.0);
-        }
-        sum
-    }
-
-    #[test]
-    fn bennett_g_chord_bounds_g_from_above_and_stays_close() {
-        let mut worst: f64 = 0.0;
-        for i in 0..=40_000 {
-            let z = i as f64 * 1e-3;
-            let g = g_series(z);
-            let chord = bennett_g_chord(z);
-            assert!(chord >= g, "z {z}: chord {chord} below g {g}");
-            assert!(
-                bennett_g(z) >= g * (1.0 - 1e-14),
-                "z {z}: bennett_g below g"
-            );
-            worst = worst.max(chord / g - 1.0);
-        }
-        // Chords of a convex function on steps of 1/4 (g bends like e^z for large z).
-        assert!(worst < 7e-3, "chord up to {worst} above g");
-        assert!(bennett_g_chord(1e3).is_infinite() && bennett_g_chord(0.0) >= 0.5);
     }
 }

@@ -5,7 +5,8 @@
 //! above by the caller), far field (one term `n w exp(-alpha r)`), exact (a leaf's
 //! primitives) or opened.
 
-use super::smooth::{EvalParams, EvalStats, Sink};
+use super::params::{EvalParams, EvalStats};
+use super::sink::Sink;
 use crate::bvh::moments::{MIDDLE, lin_bound, quadratic_form};
 use crate::bvh::wide::{EMPTY, Root};
 use crate::bvh::{Moments4, Node4};
@@ -124,9 +125,8 @@ fn exponent(v: f64) -> i64 {
 }
 
 /// Steps of the budget's charges per octave: a charge is the subtree's bound rounded up
-/// to a power of `2^(1/STEPS)` (at most 9% above it). Charges rounded up to powers of 2
-/// (up to four times the bound, the test as much stricter) spent the budget on fewer
-/// subtrees: the lidar at 1920x1080 visits 8% fewer leaves with eighths.
+/// to a power of `2^(1/STEPS)` (at most 9% above it); coarser steps (powers of 2: up to
+/// four times the bound) would spend the budget on fewer subtrees.
 const STEPS: usize = 8;
 
 /// `log2(1 + i / STEPS)`, `i = 0 .. STEPS` (the last is 1), to the nearest double

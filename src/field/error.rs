@@ -56,6 +56,10 @@ pub enum FieldError {
     Primitive(#[from] PrimitiveError),
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
+    /// A chunked array could not be written (`field::zarr`'s error, boxed so that this
+    /// module does not reach up into the writer that returns it).
+    #[error(transparent)]
+    Zarr(Box<dyn std::error::Error + Send + Sync>),
 }
 
 /// `1.5 GiB`-style rendering of a byte count.

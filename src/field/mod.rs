@@ -40,6 +40,11 @@
 //! the solid (winding number above 1/2), the winding number evaluated only in blocks of
 //! voxels where the sign can change.
 //!
+//! Boxes and chunks: [`FieldPlan`] prepares a field once (sites, BVH) and computes any
+//! box of voxels of its grid ([`FieldSource`], `plan.rs`); [`zarr`] writes a volume as a
+//! chunked Zarr v3 array one row of chunks at a time, so its memory is that of a row,
+//! not of the volume.
+//!
 //! [`DistanceField::sample`] interpolates trilinearly; [`DistanceField::lower_bound`]
 //! gives `d(x) >= d(v) - |x - v|` over the 8 surrounding voxel centres `v`, which a
 //! sphere tracer can use to skip empty space (SPEC 7).
@@ -51,20 +56,22 @@ mod error;
 mod grid;
 mod linfac;
 mod output;
+mod plan;
 mod reference;
 pub mod sign;
 mod sites;
 mod volume;
+pub mod zarr;
 
 pub use error::{FieldError, human_bytes};
 pub use grid::{DEFAULT_MARGIN, Grid, MAX_RESOLUTION, MEMORY_CAP, default_memory_limit};
 pub use output::PREVIEW_SLICES;
+pub use plan::{FieldPlan, FieldSource, VoxelBox};
 pub use sites::{Domains, SiteCounts};
 pub use volume::DistanceField;
 
-use crate::eval::EvalParams;
 use crate::mesh::Mesh;
-use crate::primitives::{AnySet, PrimitiveError, PrimitiveKind};
+use crate::primitives::{PrimitiveError, PrimitiveKind};
 use std::time::Instant;
 
 /// How the field is computed.
@@ -171,7 +178,8 @@ impl FieldStats {
 /// Computes the distance field of the `kind` primitives of `mesh` on `grid`.
 ///
 /// Validates the options (band > 0, smooth parameters), refuses grids above the memory
-/// limit, and fails like [`AnySet::build`] when the mesh lacks the requested simplices.
+/// limit, and fails like [`crate::primitives::AnySet::build`] when the mesh lacks the requested simplices.
+/// The same as a [`FieldPlan`] computing the grid's whole box.
 pub fn compute(
     mesh: &Mesh,
     kind: PrimitiveKind,
@@ -180,6 +188,35 @@ pub fn compute(
     options: &FieldOptions,
 ) -> Result<(DistanceField, FieldStats), FieldError> {
     let t_all = Instant::now();
+    validate(method, options)?;
+    // Re-validate in case the grid was built by hand.
+    let grid = Grid::new(grid.min, grid.max, grid.res)?;
+    grid.check_memory(options.memory_limit, setup_bytes(mesh))?;
+    let plan = FieldPlan::new(mesh, kind, &grid, method, options)?;
+    let mut values = vec![0.0f32; grid.len()];
+    let mut stats = plan.compute_box(&VoxelBox::whole(&grid), &mut values);
+    stats.setup_seconds = plan.setup_seconds();
+    stats.seconds = t_all.elapsed().as_secs_f64();
+    stats.voxels_per_second = grid.len() as f64 / stats.seconds.max(1e-12);
+    Ok((
+        DistanceField {
+            grid,
+            values,
+            band: options.band,
+        },
+        stats,
+    ))
+}
+
+/// Memory of the sites (linfac) or primitives and BVH (the others): a few hundred bytes
+/// per simplex.
+pub fn setup_bytes(mesh: &Mesh) -> u64 {
+    let simplices = mesh.vertices.len() + mesh.segments.len() + 3 * mesh.triangles.len();
+    256 * simplices as u64
+}
+
+/// Refuses a band that is not a positive finite distance and bad smooth parameters.
+pub(crate) fn validate(method: Method, options: &FieldOptions) -> Result<(), FieldError> {
     if let Some(b) = options.band
         && !(b > 0.0 && b.is_finite())
     {
@@ -210,78 +247,10 @@ pub fn compute(
             ));
         }
     }
-    // Re-validate in case the grid was built by hand.
-    let grid = Grid::new(grid.min, grid.max, grid.res)?;
-    // Sites (linfac) or primitives and BVH (the others): a few hundred bytes per simplex.
-    let simplices = mesh.vertices.len() + mesh.segments.len() + 3 * mesh.triangles.len();
-    grid.check_memory(options.memory_limit, 256 * simplices as u64)?;
-    let mut values = vec![0.0f32; grid.len()];
-    let mut stats = FieldStats {
-        method: method.name(),
-        voxels: grid.len(),
-        ..FieldStats::default()
-    };
-    let band = options.band;
-    match method {
-        Method::Linfac => {
-            check_kind(mesh, kind)?;
-            let t = Instant::now();
-            let (reach, mag) = scene_scales(mesh, &grid);
-            let eta = 1e-8 * reach + 1e-12 * mag;
-            // No distance in the computation exceeds `reach`: a larger band changes
-            // nothing (and its square could overflow).
-            let band = band.filter(|&b| b <= 2.0 * reach);
-            let sites = sites::build_sites(mesh, kind, options.domains, band, eta);
-            // With a band every domain is already bounded by it; culling then costs more
-            // than it saves (measured), so it only runs without a band.
-            let set = if options.cull && band.is_none() {
-                Some(AnySet::build(mesh, kind)?)
-            } else {
-                None
-            };
-            stats.setup_seconds = t.elapsed().as_secs_f64();
-            let run = linfac::run(&sites, &grid, band, set.as_ref(), &mut values);
-            let cpu = run.domain_cpu + run.raster_cpu;
-            let share = if cpu > 0.0 { run.domain_cpu / cpu } else { 0.0 };
-            stats.domain_seconds = run.range_seconds + run.slice_seconds * share;
-            stats.raster_seconds = run.slice_seconds * (1.0 - share);
-            stats.sites = sites.counts.total();
-            stats.site_counts = sites.counts;
-            stats.evaluations = run.evaluations;
-            stats.polygons = run.polygons;
-            stats.candidates = run.candidates;
-        }
-        _ => {
-            let t = Instant::now();
-            let set = AnySet::build(mesh, kind)?;
-            stats.setup_seconds = t.elapsed().as_secs_f64();
-            stats.sites = set.len();
-            let t = Instant::now();
-            match method {
-                Method::Bvh => reference::bvh(&set, &grid, band, &mut values),
-                Method::Brute => reference::brute(&set, &grid, band, &mut values),
-                Method::Smooth {
-                    alpha,
-                    max_alpha,
-                    beta,
-                } => reference::smooth(
-                    &set,
-                    &grid,
-                    &EvalParams::new(alpha, max_alpha, beta),
-                    &mut values,
-                ),
-                Method::Linfac => unreachable!(),
-            }
-            stats.raster_seconds = t.elapsed().as_secs_f64();
-            stats.evaluations = grid.len() as u64;
-        }
-    }
-    stats.seconds = t_all.elapsed().as_secs_f64();
-    stats.voxels_per_second = grid.len() as f64 / stats.seconds.max(1e-12);
-    Ok((DistanceField { grid, values, band }, stats))
+    Ok(())
 }
 
-/// The same refusals as [`AnySet::build`], without building the set.
+/// The same refusals as [`crate::primitives::AnySet::build`], without building the set.
 fn check_kind(mesh: &Mesh, kind: PrimitiveKind) -> Result<(), PrimitiveError> {
     let reason = if mesh.vertices.is_empty() {
         Some("the mesh has no vertices")

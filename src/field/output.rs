@@ -5,8 +5,30 @@ use super::error::FieldError;
 use super::volume::DistanceField;
 use crate::output::{IMAGE_8BIT, Kind, Output, OutputError};
 use image::{Rgb, RgbImage};
-use npyz::WriterBuilder;
+use std::io::Write;
 use std::path::Path;
+
+/// The header of a NumPy `.npy` file (format version 1.0) of little-endian f32 in C
+/// order with this `shape`: the magic string `\x93NUMPY`, the version `1 0`, the header's
+/// length as a little-endian u16, and a Python dict literal naming the dtype, order and
+/// shape, padded with spaces and ended by a newline so that the data starts at a
+/// multiple of 64 bytes (NumPy's own alignment; the format asks for 16 at least).
+fn npy_header_f4(shape: &[usize]) -> Vec<u8> {
+    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+    // A one-dimensional shape is written `(n,)`, as Python spells a 1-tuple.
+    let tuple = match dims.as_slice() {
+        [one] => format!("({one},)"),
+        _ => format!("({})", dims.join(", ")),
+    };
+    let mut dict = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {tuple}, }}");
+    let unpadded = 10 + dict.len() + 1;
+    dict.push_str(&" ".repeat(unpadded.next_multiple_of(64) - unpadded));
+    dict.push('\n');
+    let mut out = b"\x93NUMPY\x01\x00".to_vec();
+    out.extend_from_slice(&(dict.len() as u16).to_le_bytes());
+    out.extend_from_slice(dict.as_bytes());
+    out
+}
 
 /// Number of slices in the preview montage (fewer if the grid has fewer).
 pub const PREVIEW_SLICES: usize = 5;
@@ -23,14 +45,11 @@ impl DistanceField {
         };
         let [nz, ny, nx] = self.grid.shape();
         out.write_with(|file| {
-            let mut w = npyz::WriteOptions::<f32>::new()
-                .default_dtype()
-                .shape(&[nz as u64, ny as u64, nx as u64])
-                .writer(file)
-                .begin_nd()
-                .map_err(io)?;
-            w.extend(self.values.iter().copied()).map_err(io)?;
-            w.finish().map_err(io)?;
+            file.write_all(&npy_header_f4(&[nz, ny, nx])).map_err(io)?;
+            for chunk in self.values.chunks(1 << 16) {
+                let bytes: Vec<u8> = chunk.iter().flat_map(|v| v.to_le_bytes()).collect();
+                file.write_all(&bytes).map_err(io)?;
+            }
             Ok::<(), FieldError>(())
         })
     }
@@ -196,7 +215,28 @@ fn colour(d: f64, vmin: f64, vmax: f64) -> [u8; 3] {
 
 #[cfg(test)]
 mod tests {
-    use super::nice_step;
+    use super::{nice_step, npy_header_f4};
+
+    #[test]
+    fn npy_header_is_numpys_version_1_layout() {
+        let h = npy_header_f4(&[7, 6, 5]);
+        assert_eq!(&h[..8], b"\x93NUMPY\x01\x00");
+        let len = u16::from_le_bytes([h[8], h[9]]) as usize;
+        assert_eq!(h.len(), 10 + len);
+        assert_eq!(h.len() % 64, 0, "data must start 64-byte aligned");
+        let dict = std::str::from_utf8(&h[10..]).unwrap();
+        assert!(dict.ends_with('\n'));
+        assert_eq!(
+            dict.trim_end(),
+            "{'descr': '<f4', 'fortran_order': False, 'shape': (7, 6, 5), }"
+        );
+        let one = npy_header_f4(&[5]);
+        assert!(
+            std::str::from_utf8(&one[10..])
+                .unwrap()
+                .contains("'shape': (5,)")
+        );
+    }
 
     #[test]
     fn nice_steps() {

@@ -8,7 +8,7 @@
 //! their share of the weight. A pixel of one sample keeps its 8-bit colour exactly, so
 //! one sample per pixel gives today's images bit for bit.
 
-use crate::colour::{Linear, srgb8_to_linear, to_srgb8};
+use crate::rgb::{Linear, srgb8_to_linear, to_srgb8};
 
 /// One pixel's samples so far.
 #[derive(Clone, Copy, Debug, Default)]

@@ -1,12 +1,12 @@
 //! The cost heat map: evaluations per pixel through the inferno colormap, with a colour
 //! bar and its scale written beside the image (plotters, with the embedded DejaVu Sans
-//! font of `reports::plot`), so the picture says where the renderer spends its time.
+//! font of [`crate::font`]), so the picture says where the renderer spends its time.
 //!
 //! The scale runs from 0 to the 99.5th percentile of the pixels' counts (at least 1):
 //! a handful of pathological rays would otherwise wash the picture out. Pixels above it
 //! take the top colour, and the top label says "≥".
 
-use crate::colour::Colormap;
+use crate::rgb::Colormap;
 use plotters::prelude::*;
 
 /// Width of the panel holding the colour bar and its labels, in pixels.
@@ -41,7 +41,7 @@ pub fn heat_map(costs: &[u32], width: u32, height: u32) -> Result<image::RgbImag
             buf[i..i + 3].copy_from_slice(&rgb);
         }
     }
-    crate::reports::plot::register();
+    crate::font::register();
     {
         let root = BitMapBackend::with_buffer(&mut buf, (full_w, height)).into_drawing_area();
         let err = |e: DrawingAreaErrorKind<_>| e.to_string();

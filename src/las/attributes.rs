@@ -9,11 +9,11 @@
 //! - `intensity`: the colormap spans the 1st to 99th percentile of the kept points (a
 //!   few very bright returns would otherwise leave everything dark).
 //! - `elevation`: the colormap spans the kept points' lowest to highest z.
-//! - `classification`: the ASPRS palette ([`crate::colour::palette`]).
+//! - `classification`: the ASPRS palette ([`crate::rgb::palette`]).
 
 use super::filter::Record;
-use crate::colour::colormap::quantile_range;
-use crate::colour::{Colormap, Linear, palette, srgb8_to_linear};
+use crate::rgb::colormap::quantile_range;
+use crate::rgb::{Colormap, Linear, palette, srgb8_to_linear};
 
 /// Which attribute gives a lidar point its colour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

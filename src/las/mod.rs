@@ -19,9 +19,8 @@ pub mod layout_check;
 pub use attributes::ColorBy;
 pub use filter::{FilterCount, LasFilters, NOISE_CLASSES, Returns, Thin};
 
-use crate::colour::{Colormap, Linear};
 use crate::mesh::{Mesh, MeshError};
-use crate::primitives::PrimitiveKind;
+use crate::rgb::{Colormap, Linear};
 use attributes::AttributeColumn;
 use filter::{Record, Stream, VoxelThin};
 use glam::{DVec3, Vec3};
@@ -254,35 +253,6 @@ pub fn read(path: &Path, options: &LasOptions) -> Result<LasCloud, MeshError> {
         header_points: total,
         header_bounds,
     })
-}
-
-/// Loads any mesh file for the command line's `query` and `field`: a lidar file with the
-/// default filters (asking it for anything but points is an error naming the file),
-/// other files through [`Mesh::load`]. Returns the mesh and the origin its coordinates
-/// are relative to (zero for non-lidar files): `file = origin + mesh`.
-pub fn load_mesh(path: &Path, kinds: &[PrimitiveKind]) -> Result<(Mesh, DVec3), MeshError> {
-    if !is_lidar_path(path) {
-        return Ok((Mesh::load(path)?, DVec3::ZERO));
-    }
-    if let Some(kind) = kinds.iter().find(|k| **k != PrimitiveKind::Points) {
-        return Err(format_error(
-            path,
-            format!("a LAS/LAZ file holds points only, so it cannot give {kind}; use points"),
-        ));
-    }
-    let cloud = read(path, &LasOptions::default())?;
-    Ok((cloud.mesh, cloud.origin))
-}
-
-/// A scene object's mesh file: a lidar file read with the object's `options` (filters,
-/// origin), any other file through [`Mesh::load`]. For callers that need the points
-/// only (the renderer reads [`read`] itself to keep the colours and counts).
-pub fn load_scene_mesh(path: &Path, options: &LasOptions) -> Result<Mesh, MeshError> {
-    if is_lidar_path(path) {
-        Ok(read(path, options)?.mesh)
-    } else {
-        Mesh::load(path)
-    }
 }
 
 /// Keeps the items whose flag is set, in order.

@@ -16,6 +16,7 @@ mod vertex_colours;
 
 pub use error::MeshError;
 
+use crate::rgb::Linear;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::path::Path;
@@ -96,19 +97,14 @@ fn extension(path: &Path) -> String {
 }
 
 impl Mesh {
-    /// Reads a mesh, choosing the reader by extension (`.obj`, `.ply`, `.stl`, any case).
-    /// Lidar files (`.las`, `.laz`) give their points with the default filters (noise
-    /// classes dropped), recentred on the header's box centre ([`crate::las`]).
-    /// The path must be a regular file of at most [`crate::limits::MAX_INPUT_BYTES`].
+    /// Reads a mesh file, choosing the reader by extension (`.obj`, `.ply`, `.stl`, any
+    /// case). Lidar files are read by [`crate::las`]; [`crate::load::load_mesh`] reads
+    /// either kind. The path must be a regular file of at most
+    /// [`crate::limits::MAX_INPUT_BYTES`].
     ///
     /// Errors name the file and what was wrong; a mesh with no vertices is an error.
     pub fn load(path: &Path) -> Result<Mesh, MeshError> {
         let ext = extension(path);
-        if matches!(ext.as_str(), "las" | "laz") {
-            let mesh = crate::las::read(path, &Default::default())?.mesh;
-            mesh.validate(path)?;
-            return Ok(mesh);
-        }
         if !matches!(ext.as_str(), "obj" | "ply" | "stl") {
             return Err(MeshError::UnknownExtension {
                 path: path.to_path_buf(),
@@ -120,6 +116,31 @@ impl Mesh {
             source,
         })?;
         Mesh::from_bytes(bytes, path)
+    }
+
+    /// Reads a mesh and its per-vertex colours (see [`vertex_colours`]): `Ok((mesh, None))`
+    /// when the file has none. Errors name the file, and the property, vertex or line
+    /// of a colour that cannot be used.
+    pub fn load_with_vertex_colours(path: &Path) -> Result<(Mesh, Option<Vec<Linear>>), MeshError> {
+        let ext = extension(path);
+        if !matches!(ext.as_str(), "obj" | "ply") {
+            return Ok((Mesh::load(path)?, None));
+        }
+        let bytes = crate::limits::read_input_file(path).map_err(|source| MeshError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let (mut mesh, colours) = if ext == "ply" {
+            ply::parse_ply_coloured(&bytes, path, true)?
+        } else {
+            obj::parse_obj_coloured(&bytes, path, true)?
+        };
+        mesh.name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        mesh.validate(path)?;
+        Ok((mesh, colours))
     }
 
     /// Parses a whole mesh file held in memory, choosing the reader by the extension of

@@ -30,7 +30,7 @@
 //! The file is read whole and parsed as bytes, without a per-line allocation.
 
 use super::{Mesh, MeshError, vertex_colours};
-use crate::colour::Linear;
+use crate::rgb::Linear;
 use glam::Vec3;
 use std::path::Path;
 

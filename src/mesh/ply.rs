@@ -12,10 +12,10 @@
 //!   [`Mesh::segments`].
 //!
 //! Elements are parsed into small typed structs (ply-rs-bw's `PropertyAccess`), not its
-//! `DefaultElement` hash maps: 8 M float vertices parse in about 0.2 s in release. Binary
-//! files holding only float vertices are decoded directly instead
-//! ([`super::ply_binary`]: bytes -> `f32` at a fixed stride, in parallel, about 20 ms
-//! for the same 8 M), after the same header checks.
+//! `DefaultElement` hash maps, which allocate a map per element. Binary files holding
+//! only float vertices are decoded directly instead ([`super::ply_binary`]: bytes ->
+//! `f32` at a fixed stride, in parallel), after the same header checks. (Timings of
+//! both: `doc/performance-log.md`, "Notes moved from module docs".)
 //!
 //! Header errors and ASCII payload errors carry the 1-based line ([`MeshError::Parse`]);
 //! binary payload errors (a truncated file) are [`MeshError::Format`]. Malformed files
@@ -24,7 +24,7 @@
 
 use super::vertex_colours::{self, PLY_COLOUR_NAMES};
 use super::{Mesh, MeshError, ply_binary, ply_check};
-use crate::colour::Linear;
+use crate::rgb::Linear;
 use glam::Vec3;
 use ply_rs_bw::parser::{ParseError, Parser, Reader};
 use ply_rs_bw::ply::{
@@ -35,9 +35,9 @@ use std::path::Path;
 /// Names of the face list property we accept (a face element with both is rejected).
 const FACE_LIST_NAMES: [&str; 2] = ["vertex_indices", "vertex_index"];
 
-/// Parses a whole PLY file held in `bytes`; `path` is only used in errors. (Reading the
-/// file whole was measured faster than streaming it through a `BufReader`, at the cost
-/// of holding the file and the vertices at once: about 200 MB for 8 M points.)
+/// Parses a whole PLY file held in `bytes`; `path` is only used in errors. The caller
+/// reads the file whole rather than streaming it through a `BufReader` (faster, see the
+/// performance log), so the file and the vertices are held at once.
 pub(super) fn parse_ply(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
     Ok(parse_ply_coloured(bytes, path, false)?.0)
 }

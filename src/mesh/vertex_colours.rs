@@ -1,5 +1,7 @@
-//! Per-vertex colours stored in mesh files, read only when a scene colours an object by
-//! them (`color_by = "vertex"`); [`Mesh::load`] ignores them.
+//! Per-vertex colours stored in mesh files: the channel decoding both readers call
+//! ([`channel`], [`PLY_COLOUR_NAMES`]). They are read only when a scene colours an
+//! object by them (`color_by = "vertex"`, [`Mesh::load_with_vertex_colours`]);
+//! [`Mesh::load`] ignores them.
 //!
 //! The colours are kept beside the [`Mesh`] (one linear RGB colour per vertex), not in
 //! it: a mesh is built in many places (generators, the Python arrays, transforms) that
@@ -20,9 +22,9 @@
 //!   naming the line.
 //! - Other formats (STL) have no per-vertex colours.
 
-use super::{Mesh, MeshError, extension};
-use crate::colour::{Linear, srgb_to_linear};
-use std::path::Path;
+#[cfg(doc)]
+use super::Mesh;
+use crate::rgb::srgb_to_linear;
 
 /// The PLY spellings of the three colour channels, in the order they are looked for.
 pub(super) const PLY_COLOUR_NAMES: [[&str; 3]; 3] = [
@@ -30,33 +32,6 @@ pub(super) const PLY_COLOUR_NAMES: [[&str; 3]; 3] = [
     ["diffuse_red", "diffuse_green", "diffuse_blue"],
     ["r", "g", "b"],
 ];
-
-impl Mesh {
-    /// Reads a mesh and its per-vertex colours (see the module docs): `Ok((mesh, None))`
-    /// when the file has none. Errors name the file, and the property, vertex or line
-    /// of a colour that cannot be used.
-    pub fn load_with_vertex_colours(path: &Path) -> Result<(Mesh, Option<Vec<Linear>>), MeshError> {
-        let ext = extension(path);
-        if !matches!(ext.as_str(), "obj" | "ply") {
-            return Ok((Mesh::load(path)?, None));
-        }
-        let bytes = crate::limits::read_input_file(path).map_err(|source| MeshError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        let (mut mesh, colours) = if ext == "ply" {
-            super::ply::parse_ply_coloured(&bytes, path, true)?
-        } else {
-            super::obj::parse_obj_coloured(&bytes, path, true)?
-        };
-        mesh.name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        mesh.validate(path)?;
-        Ok((mesh, colours))
-    }
-}
 
 /// A colour channel read as a fraction (0..1 nominal) to linear light, or why not.
 pub(super) fn channel(value: f32) -> Result<f32, String> {

@@ -10,9 +10,10 @@
 
 use super::object::TraceObject;
 use super::tracer::Hit;
+use crate::colour::SetColours;
 use crate::colour::by_geometry::normal_colour;
-use crate::colour::{Linear, SetColours, srgb8_to_linear, to_srgb8};
 use crate::eval::colour::colour_at;
+use crate::rgb::{Linear, srgb8_to_linear, to_srgb8};
 
 /// The MatCap luminance that shows the albedo unchanged.
 pub const MATCAP_WHITE: f32 = 0.8;

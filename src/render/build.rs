@@ -244,7 +244,8 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
     let settings = match &scene.framing {
         Some(f) => {
             let aspect = f64::from(scene.image.width) / f64::from(scene.image.height);
-            crate::framing::fit_objects(&objects, aspect, f).unwrap_or(scene.camera)
+            crate::framing::fit_boxes(objects.iter().map(TraceObject::reach_bounds), aspect, f)
+                .unwrap_or(scene.camera)
         }
         None => scene.camera,
     };

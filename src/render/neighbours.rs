@@ -21,7 +21,7 @@
 //! before a hit have values of a few to tens of epsilons: the balls of the rays traced
 //! just before (the tile's quarters are traced in Z order, so these are mostly the
 //! pixels to the left and above) carry a ray past some of its bound steps and often its
-//! first full evaluation (README, round eight).
+//! first full evaluation (doc/performance-log.md, round eight).
 //! The last axis sample of each cone march that encloses the ray (`render::cone`) is a
 //! ball too: the march stops where the cone's radius eats half of its value, but a ray
 //! off the axis by `c` still meets that ball on a chord of half-length `sqrt(s^2 - c^2)`.

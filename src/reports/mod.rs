@@ -10,6 +10,7 @@
 
 pub mod bench;
 pub mod compare;
+pub mod matrix;
 pub mod plot;
 pub mod stability;
 pub mod sweep;

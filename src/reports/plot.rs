@@ -1,25 +1,8 @@
-//! PNG plots of the sweep with plotters' bitmap backend. Text needs a font: DejaVu Sans
-//! is embedded (`assets/DejaVuSans.ttf`, license in `assets/DejaVu-LICENSE.txt`) and
-//! registered once as "sans-serif".
+//! PNG plots of the sweep with plotters' bitmap backend. Text needs a font: the embedded
+//! one of [`crate::font`], registered before drawing.
 
 use plotters::prelude::*;
-use plotters::style::{FontStyle, register_font};
 use std::path::Path;
-use std::sync::Once;
-
-static FONT: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
-
-/// Registers the embedded font as "sans-serif" (once); needed before any text is drawn.
-pub(crate) fn register() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        // The font is compiled in: it cannot fail to parse unless the asset is broken,
-        // which the plot tests would show at once.
-        if register_font("sans-serif", FontStyle::Normal, FONT).is_err() {
-            panic!("assets/DejaVuSans.ttf is not a valid font");
-        }
-    });
-}
 
 /// Plotting failed (the drawing backend's message).
 #[derive(Debug, thiserror::Error)]
@@ -114,7 +97,7 @@ fn err<E: std::fmt::Debug>(path: &Path) -> impl Fn(E) -> PlotError + '_ {
 /// Two panels: render time against beta (log scale), and the isosurface error (percent
 /// of the diagonal: mean solid, 95th percentile dashed) against render time.
 pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<(), PlotError> {
-    register();
+    crate::font::register();
     let e = err(path);
     let (width, height) = (1400u32, 660u32);
     let mut buf = vec![0u8; (width * height * 3) as usize];
@@ -245,7 +228,7 @@ pub fn sweep_plot(path: &Path, title: &str, series: &[SweepSeries]) -> Result<()
 /// median per beta (robust to the odd query preempted by another process) as a line
 /// with markers labelled by beta.
 pub fn grid_plot(path: &Path, title: &str, series: &[GridSeries]) -> Result<(), PlotError> {
-    register();
+    crate::font::register();
     let e = err(path);
     let (width, height) = (1000u32, 700u32);
     let mut buf = vec![0u8; (width * height * 3) as usize];

@@ -405,7 +405,7 @@ fn grid_object(scene: &Scene) -> Result<(Vec<AnySet>, f64, f64), SweepError> {
     let obj = &scene.objects[0];
     let mut mesh = match &obj.geometry {
         Geometry::Mesh(p) => {
-            crate::las::load_scene_mesh(p, &obj.las).map_err(|e| fail(e.to_string()))?
+            crate::load::load_scene_mesh(p, &obj.las).map_err(|e| fail(e.to_string()))?
         }
         Geometry::Generator(g) => g.build().map_err(|e| fail(e.to_string()))?,
     };

@@ -26,13 +26,13 @@ pub use crate::matcap::MatCapSpec;
 pub use error::{Location, SceneError};
 pub use transform::Transform;
 
+pub use crate::camera::CameraSettings;
 use crate::camera::{Camera, CameraError};
 use crate::film::{AaMode, FilmOptions, Filter};
 pub use crate::framing::Framing;
 pub use crate::las::LasOptions;
 use crate::primitives::PrimitiveKind;
 use crate::procedural::Generator;
-use glam::DVec3;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -54,17 +54,6 @@ pub struct Scene {
     pub objects: Vec<Object>,
     /// Where the checked values were read from, and their values then.
     origins: Origins,
-}
-
-/// `[camera]`: a pinhole camera (SPEC 7).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CameraSettings {
-    pub origin: DVec3,
-    pub target: DVec3,
-    /// Default `[0, 1, 0]`.
-    pub up: DVec3,
-    /// Vertical field of view in degrees, in (0, 180). Default 53.13.
-    pub fov: f64,
 }
 
 /// `[image]`.
@@ -235,23 +224,6 @@ impl Default for RenderSettings {
             aa: AaMode::Uniform,
             filter: Filter::Box,
         }
-    }
-}
-
-impl CameraSettings {
-    /// A camera with the default up vector and field of view.
-    pub fn looking_at(origin: DVec3, target: DVec3) -> CameraSettings {
-        CameraSettings {
-            origin,
-            target,
-            up: DVec3::Y,
-            fov: Camera::DEFAULT_FOV_Y,
-        }
-    }
-
-    /// The camera for an image of this size.
-    pub fn build(&self, width: u32, height: u32) -> Result<Camera, CameraError> {
-        Camera::new(self.origin, self.target, self.up, self.fov, width, height)
     }
 }
 

@@ -221,19 +221,28 @@ impl<'a> Raster<'a> {
 }
 
 /// Computes the field into `out` (length `grid.len()`, C order) from `sites`; `cull`
-/// is the primitive set whose nearest queries bound the tiles (no culling if `None`).
+/// is the primitive set whose nearest queries bound the tiles (no culling if `None`);
+/// `active`, if given, leaves out the sites marked `false` (sites that cannot be the
+/// closest feature anywhere in the grid, see `field::plan`).
 pub(crate) fn run(
     sites: &Sites,
     grid: &Grid,
     band: Option<f64>,
     cull: Option<&AnySet>,
+    active: Option<&[bool]>,
     out: &mut [f32],
 ) -> LinfacRun {
     let t = Instant::now();
     let raster = Raster::new(sites, grid, cull);
     let ranges: Vec<(usize, usize)> = (0..sites.sites.len())
         .into_par_iter()
-        .map_init(Scratch::default, |s, idx| raster.slice_range(idx, s))
+        .map_init(Scratch::default, |s, idx| {
+            if active.is_none_or(|a| a[idx]) {
+                raster.slice_range(idx, s)
+            } else {
+                (1, 0)
+            }
+        })
         .collect();
     let candidates: u64 = ranges
         .iter()

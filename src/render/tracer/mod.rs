@@ -43,12 +43,8 @@
 //!    terms hold together less than `tol = min(0.025 alpha epsilon, 1e-2)` of the sum
 //!    are skipped and covered from above, which lowers `s` by at most `2 tol / alpha`, 5%
 //!    of epsilon (`eval::smooth`; queries keep the default 1e-10). The cap binds where
-//!    `alpha epsilon` exceeds 0.4 (the triangle meshes of Table 1, the lidar at 0.58). On the
-//!    point clouds this visits 25-30% fewer leaves for the same march than the default
-//!    (the lidar 7% fewer again than with the earlier cap at 1e-3); a factor of 0.025
-//!    instead of 0.005 another 9-13% fewer (960x540: lidar 169.6 -> 147.9, deer at
-//!    alpha 2 54.0 -> 49.4 leaves per ray), for an exact value at the hits 0.02-0.03
-//!    epsilons higher (a trade paid for by the final step, item 4; README, round twelve).
+//!    `alpha epsilon` exceeds 0.4. What each setting bought (leaves per ray against the
+//!    accuracy at the hits) is in doc/performance-log.md, rounds ten and twelve.
 //! 7. The normal is the normalised gradient at the hit. Steps need only the value, so
 //!    they use value-only evaluations; an evaluation predicted to hit (its predecessor's
 //!    value within two epsilons, or a linear extrapolation of the last two values

@@ -8,8 +8,9 @@
 use super::super::error::SceneError;
 use super::super::raw::{RawCrop, RawObject, RawThin};
 use super::Resolver;
-use crate::colour::{Colormap, GeometryColorBy, GeometryColouring};
+use crate::colour::{GeometryColorBy, GeometryColouring};
 use crate::las::{ColorBy, LasFilters, LasOptions, NOISE_CLASSES, Returns, Thin};
+use crate::rgb::Colormap;
 use glam::DVec3;
 use toml::Spanned;
 

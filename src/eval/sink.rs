@@ -1,0 +1,234 @@
+//! Where a Barnes-Hut walk's terms go (SPEC 2, 6): the accumulator, with the gradient,
+//! and the terms' slopes along a ray (`eval::reach`). Far-field terms are the closest-box
+//! term or, for point clouds, the second-moment bound (Bennett's inequality; the
+//! `eval::smooth` module docs state both and why each dominates the terms it replaces).
+
+use super::accumulate::Accumulator;
+use super::reach::Slopes;
+use crate::primitives::{Primitive, WeightScale};
+use glam::DVec3;
+
+/// `g(z) = (e^z - 1 - z) / z^2` for `z >= 0`, from above (to a relative 1e-11): its
+/// Taylor series `sum z^k / (k + 2)!` to `k = 9` (remainder below `z^10 / 12!`) under
+/// 0.5, else from `exp` (no cancellation there), `+inf` past 700.
+#[inline]
+pub(crate) fn bennett_g(z: f64) -> f64 {
+    if z < 0.5 {
+        const C: [f64; 10] = [
+            1.0 / 2.0,
+            1.0 / 6.0,
+            1.0 / 24.0,
+            1.0 / 120.0,
+            1.0 / 720.0,
+            1.0 / 5040.0,
+            1.0 / 40320.0,
+            1.0 / 362880.0,
+            1.0 / 3628800.0,
+            1.0 / 39916800.0,
+        ];
+        C.iter().rev().fold(0.0, |acc, &c| acc * z + c) + 1e-11
+    } else if z < 700.0 {
+        (z.exp() - 1.0 - z) / (z * z)
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Grid step of [`bennett_g_chord`]'s table, and the grid's end.
+const G_STEP: f64 = 0.25;
+const G_END: f64 = 32.0;
+const G_POINTS: usize = (G_END / G_STEP) as usize + 1;
+
+/// `bennett_g` at the grid points `k G_STEP`, rounded up.
+static G_TABLE: std::sync::LazyLock<[f64; G_POINTS]> = std::sync::LazyLock::new(|| {
+    std::array::from_fn(|k| bennett_g(k as f64 * G_STEP) * (1.0 + 1e-12))
+});
+
+/// An upper bound of `g(z)` for `z >= 0` that costs no exponential: `g` is convex (its
+/// Taylor coefficients are positive), so on each grid interval the chord through its
+/// ends lies above it (by at most 0.7%: `e^z` over a quarter bends that much); past the
+/// grid, `bennett_g` itself (both rounded up by a relative 1e-12, above the rounding of
+/// `exp`). Saves the far-field terms of point clouds one exponential each.
+#[inline]
+pub(crate) fn bennett_g_chord(z: f64) -> f64 {
+    if z < G_END {
+        let table = &*G_TABLE;
+        let u = z.max(0.0) * (1.0 / G_STEP);
+        let k = (u as usize).min(G_POINTS - 2);
+        let (lo, hi) = (table[k], table[k + 1]);
+        lo + (hi - lo) * (u - k as f64)
+    } else {
+        bennett_g(z) * (1.0 + 1e-12)
+    }
+}
+
+/// Where a traversal's terms go: the accumulator, with the gradient if `GRAD`, and the
+/// terms' slopes along `u`, binned for the free distance, if `SLOPE` (`eval::reach`).
+pub(crate) struct Sink<'a, const GRAD: bool, const SLOPE: bool> {
+    pub acc: &'a mut Accumulator,
+    pub slopes: &'a mut Slopes,
+    pub u: DVec3,
+}
+
+impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
+    /// The slope bins follow the accumulator's shift when a term lowers it.
+    #[inline]
+    fn add_slope(&mut self, m_before: f64, e: f64, a: f64) {
+        if self.acc.m < m_before {
+            let alpha = self.acc.alpha();
+            self.slopes
+                .rescale((-alpha * (m_before - self.acc.m)).exp());
+        }
+        self.slopes.add(e, a);
+    }
+
+    /// The far-field term of a subtree with box `min..max` at squared distance `r2 > 0`.
+    /// A middle (`other` = its farther child's box, the term at the nearer one's
+    /// distance) takes the smaller of the two boxes' slopes along the ray: each child's
+    /// distance is at least its own box's linear bound, and the nearer box's distance at
+    /// the sample is the smaller, so that line bounds both ahead (`eval::reach`).
+    #[inline]
+    pub fn far(
+        &mut self,
+        x: DVec3,
+        r2: f64,
+        weight: f64,
+        (min, max): (DVec3, DVec3),
+        other: Option<(DVec3, DVec3)>,
+    ) {
+        let r = r2.sqrt();
+        let m = self.acc.m;
+        let slope_other = |u: DVec3| {
+            other.map_or(1.0, |(lo, hi)| {
+                let v = x - x.clamp(lo, hi);
+                let d = v.length();
+                if d > 0.0 { v.dot(u) / d } else { -1.0 }
+            })
+        };
+        if GRAD {
+            let dir = (x - x.clamp(min, max)) / r;
+            let e = self.acc.add(r, weight, dir, DVec3::ZERO);
+            if SLOPE {
+                self.add_slope(m, e, dir.dot(self.u).min(slope_other(self.u)));
+            }
+        } else if SLOPE {
+            let a = (x - x.clamp(min, max)).dot(self.u) / r;
+            let e = self.acc.add_value(r, weight);
+            self.add_slope(m, e, a.min(slope_other(self.u)));
+        } else {
+            self.acc.add_value(r, weight);
+        }
+    }
+
+    /// The far-field term of a subtree of `n` points of weight at most `w` (`weight =
+    /// n w`) in the box `bx` at squared distance `r2 > 0` from `x` (closest-box term in
+    /// `near`: its squared distance, box and, for a middle, the farther child's box),
+    /// from their second moment about the
+    /// reference point `c` (`sigma2(u) >= u^T M u`) whose distance to their mean is at
+    /// most `lin` (module docs): the moment bound where it is below the box term.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn far_moments(
+        &mut self,
+        x: DVec3,
+        weight: f64,
+        bx: (DVec3, DVec3),
+        c: DVec3,
+        sigma2: impl Fn(DVec3) -> f64,
+        lin: f64,
+        (r2, near, other): (f64, (DVec3, DVec3), Option<(DVec3, DVec3)>),
+    ) {
+        let v = x - c;
+        let l2 = v.length_squared();
+        if l2 > 0.0 {
+            let alpha = self.acc.alpha();
+            let l = l2.sqrt();
+            let u = v * (1.0 / l);
+            // The largest u . (q - c) over the box bounds every point's.
+            let far_corner = DVec3::select(u.cmpge(DVec3::ZERO), bx.1, bx.0);
+            let z = alpha * u.dot(far_corner - c).max(0.0);
+            let f = (1.0 + alpha * lin + alpha * alpha * sigma2(u).max(0.0) * bennett_g_chord(z))
+                * (1.0 + 1e-9);
+            // ln f <= f - 1: where `f - 1 <= alpha (l - r)` the moment term is the smaller.
+            let reach = l - (f - 1.0) / alpha;
+            if reach >= 0.0 && reach * reach >= r2 {
+                self.term(l, weight * f, u);
+                return;
+            }
+        }
+        self.far(x, r2, weight, near, other);
+    }
+
+    /// A far-field term at distance `d` with unit direction `dir` (the gradient of `d`,
+    /// and its slope along the ray is `dir . u` exactly).
+    #[inline]
+    fn term(&mut self, d: f64, weight: f64, dir: DVec3) {
+        let m = self.acc.m;
+        if GRAD {
+            let e = self.acc.add(d, weight, dir, DVec3::ZERO);
+            if SLOPE {
+                self.add_slope(m, e, dir.dot(self.u));
+            }
+        } else if SLOPE {
+            let e = self.acc.add_value(d, weight);
+            self.add_slope(m, e, dir.dot(self.u));
+        } else {
+            self.acc.add_value(d, weight);
+        }
+    }
+
+    /// A primitive's exact term.
+    #[inline]
+    pub fn exact<P: Primitive>(&mut self, prim: &P, x: DVec3, scale: &WeightScale) {
+        let m = self.acc.m;
+        if GRAD {
+            let t = prim.term(x, scale);
+            let e = self.acc.add(t.d, t.w, t.dir, t.grad_w);
+            if SLOPE {
+                self.add_slope(m, e, t.dir.dot(self.u));
+            }
+        } else if SLOPE {
+            let (d, w, a) = prim.value_slope(x, self.u, scale);
+            let e = self.acc.add_value(d, w);
+            self.add_slope(m, e, a);
+        } else {
+            let (d, w) = prim.value(x, scale);
+            self.acc.add_value(d, w);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `g(z)` in long arithmetic: its series to convergence (all terms positive).
+    fn g_series(z: f64) -> f64 {
+        let (mut term, mut sum, mut k) = (0.5f64, 0.0f64, 0.0f64);
+        while term > 1e-18 * sum.max(1e-300) || k < 3.0 {
+            sum += term;
+            k += 1.0;
+            term *= z / (k + 2.0);
+        }
+        sum
+    }
+
+    #[test]
+    fn bennett_g_chord_bounds_g_from_above_and_stays_close() {
+        let mut worst: f64 = 0.0;
+        for i in 0..=40_000 {
+            let z = i as f64 * 1e-3;
+            let g = g_series(z);
+            let chord = bennett_g_chord(z);
+            assert!(chord >= g, "z {z}: chord {chord} below g {g}");
+            assert!(
+                bennett_g(z) >= g * (1.0 - 1e-14),
+                "z {z}: bennett_g below g"
+            );
+            worst = worst.max(chord / g - 1.0);
+        }
+        // Chords of a convex function on steps of 1/4 (g bends like e^z for large z).
+        assert!(worst < 7e-3, "chord up to {worst} above g");
+        assert!(bennett_g_chord(1e3).is_infinite() && bennett_g_chord(0.0) >= 0.5);
+    }
+}
