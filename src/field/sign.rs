@@ -21,8 +21,9 @@
 //! Voxels outside a narrow band (`+inf`) count as at least `band` from the surface and
 //! become `-inf` inside.
 
+use super::plan::{FieldPlan, FieldSource, VoxelBox};
 use super::volume::DistanceField;
-use super::{FieldError, grid::Grid};
+use super::{FieldError, FieldStats, Method, grid::Grid};
 use crate::mesh::Mesh;
 use crate::winding::{Solid, batch, boundary::Boundary, sign};
 use glam::DVec3;
@@ -55,6 +56,91 @@ struct Block {
     hi: [usize; 3],
 }
 
+/// The far fields and the boundary of a triangle soup, built once and used to sign any
+/// number of volumes or boxes of one.
+pub struct Signer {
+    solid: Solid,
+    boundary: Boundary,
+    setup_seconds: f64,
+}
+
+impl Signer {
+    /// The signer of `mesh`'s triangles with the far-field parameter `beta`.
+    pub fn new(mesh: &Mesh, beta: f64) -> Result<Signer, FieldError> {
+        let t = Instant::now();
+        let solid = Solid::from_mesh(mesh, beta)?;
+        let boundary = Boundary::of(mesh);
+        Ok(Signer {
+            solid,
+            boundary,
+            setup_seconds: t.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Seconds spent building the far fields and the boundary.
+    pub fn setup_seconds(&self) -> f64 {
+        self.setup_seconds
+    }
+
+    /// Negates the values (exact unsigned distances on `grid`, C order, `+inf` beyond
+    /// `band`) that lie inside the solid. `setup_seconds` is left at 0.
+    pub fn sign(&self, grid: &Grid, values: &mut [f32], band: Option<f64>) -> SignStats {
+        let t_all = Instant::now();
+        let (solid, boundary) = (&self.solid, &self.boundary);
+        let mut stats = SignStats {
+            boundary_edges: boundary.edges,
+            ..SignStats::default()
+        };
+        let tops = top_blocks(grid);
+        let view = Values {
+            grid,
+            values: &*values,
+            band,
+        };
+        let results: Vec<Outcome> = tops
+            .par_iter()
+            .map_init(Vec::new, |stack, &b| {
+                let mut out = Outcome::default();
+                split(&view, solid, boundary, b, stack, &mut out);
+                out
+            })
+            .collect();
+        let mut leaves = Vec::new();
+        for r in &results {
+            stats.block_evaluations += r.evaluations;
+            for &(b, inside) in &r.filled {
+                if inside {
+                    for k in b.lo[2]..b.hi[2] {
+                        for j in b.lo[1]..b.hi[1] {
+                            let row = grid.index(0, j, k);
+                            for v in &mut values[row + b.lo[0]..row + b.hi[0]] {
+                                *v = -*v;
+                            }
+                            stats.inside += (b.hi[0] - b.lo[0]) as u64;
+                        }
+                    }
+                }
+            }
+            leaves.extend_from_slice(&r.leaves);
+        }
+        let centres: Vec<DVec3> = leaves
+            .par_iter()
+            .map(|&[i, j, k]| grid.voxel_center(i as usize, j as usize, k as usize))
+            .collect();
+        let w = batch::sign_winding_numbers(solid.tree(), solid.triangles(), solid.beta, &centres);
+        stats.voxel_evaluations = leaves.len() as u64;
+        for (&[i, j, k], &w) in leaves.iter().zip(&w) {
+            if sign(w) < 0.0 {
+                let v = &mut values[grid.index(i as usize, j as usize, k as usize)];
+                *v = -*v;
+                stats.inside += 1;
+            }
+        }
+        stats.seconds = t_all.elapsed().as_secs_f64();
+        stats
+    }
+}
+
 /// Negates the voxels of `field` (exact unsigned distances of `mesh`'s triangles) that
 /// lie inside the solid, with the far-field parameter `beta`.
 pub fn sign_field(
@@ -62,58 +148,67 @@ pub fn sign_field(
     field: &mut DistanceField,
     beta: f64,
 ) -> Result<SignStats, FieldError> {
-    let t_all = Instant::now();
-    let solid = Solid::from_mesh(mesh, beta)?;
-    let boundary = Boundary::of(mesh);
-    let mut stats = SignStats {
-        boundary_edges: boundary.edges,
-        setup_seconds: t_all.elapsed().as_secs_f64(),
-        ..SignStats::default()
-    };
-    let grid = field.grid;
-    let tops = top_blocks(&grid);
-    let field_ref = &*field;
-    let results: Vec<Outcome> = tops
-        .par_iter()
-        .map_init(Vec::new, |stack, &b| {
-            let mut out = Outcome::default();
-            split(field_ref, &solid, &boundary, b, stack, &mut out);
-            out
-        })
-        .collect();
-    let mut leaves = Vec::new();
-    for r in &results {
-        stats.block_evaluations += r.evaluations;
-        for &(b, inside) in &r.filled {
-            if inside {
-                for k in b.lo[2]..b.hi[2] {
-                    for j in b.lo[1]..b.hi[1] {
-                        let row = grid.index(0, j, k);
-                        for v in &mut field.values[row + b.lo[0]..row + b.hi[0]] {
-                            *v = -*v;
-                        }
-                        stats.inside += (b.hi[0] - b.lo[0]) as u64;
-                    }
-                }
-            }
-        }
-        leaves.extend_from_slice(&r.leaves);
-    }
-    let centres: Vec<DVec3> = leaves
-        .par_iter()
-        .map(|&[i, j, k]| grid.voxel_center(i as usize, j as usize, k as usize))
-        .collect();
-    let w = batch::sign_winding_numbers(solid.tree(), solid.triangles(), solid.beta, &centres);
-    stats.voxel_evaluations = leaves.len() as u64;
-    for (&[i, j, k], &w) in leaves.iter().zip(&w) {
-        if sign(w) < 0.0 {
-            let v = &mut field.values[grid.index(i as usize, j as usize, k as usize)];
-            *v = -*v;
-            stats.inside += 1;
-        }
-    }
-    stats.seconds = t_all.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let signer = Signer::new(mesh, beta)?;
+    let mut stats = signer.sign(&field.grid, &mut field.values, field.band);
+    stats.setup_seconds = signer.setup_seconds;
+    stats.seconds = t.elapsed().as_secs_f64();
     Ok(stats)
+}
+
+/// A signed field prepared for computing boxes ([`FieldSource`]): the exact distance of
+/// the plan, signed box by box. A box's blocks start at its own corner, so a voxel's
+/// sign is decided by the same winding-number tests as in a whole volume, up to which
+/// block holds it (a block is signed only where its test is conclusive: module docs).
+pub struct SignedPlan {
+    plan: FieldPlan,
+    signer: Signer,
+}
+
+impl SignedPlan {
+    /// The exact-distance `plan` of `mesh`'s triangles, signed with far-field `beta`.
+    pub fn new(plan: FieldPlan, mesh: &Mesh, beta: f64) -> Result<SignedPlan, FieldError> {
+        if matches!(plan.method(), Method::Smooth { .. }) {
+            return Err(FieldError::SmoothNotSigned);
+        }
+        Ok(SignedPlan {
+            plan,
+            signer: Signer::new(mesh, beta)?,
+        })
+    }
+
+    /// Seconds spent preparing the distances and the far fields.
+    pub fn setup_seconds(&self) -> f64 {
+        self.plan.setup_seconds() + self.signer.setup_seconds
+    }
+}
+
+impl FieldSource for SignedPlan {
+    fn grid(&self) -> &Grid {
+        self.plan.grid()
+    }
+
+    fn compute_box(&self, b: &VoxelBox, out: &mut [f32]) -> FieldStats {
+        let mut stats = self.plan.compute_box(b, out);
+        let sub = self.plan.grid().sub_grid(b);
+        let signed = self.signer.sign(&sub, out, self.plan.band());
+        stats.seconds += signed.seconds;
+        stats.voxels_per_second = b.len() as f64 / stats.seconds.max(1e-12);
+        stats
+    }
+}
+
+/// The values a block test reads: a grid's C-order values and its band.
+struct Values<'a> {
+    grid: &'a Grid,
+    values: &'a [f32],
+    band: Option<f64>,
+}
+
+impl Values<'_> {
+    fn get(&self, i: usize, j: usize, k: usize) -> f32 {
+        self.values[self.grid.index(i, j, k)]
+    }
 }
 
 /// The blocks of one top block: filled with a sign, or single voxels left to evaluate.
@@ -139,14 +234,14 @@ fn top_blocks(grid: &Grid) -> Vec<Block> {
 }
 
 fn split(
-    field: &DistanceField,
+    field: &Values<'_>,
     solid: &Solid,
     boundary: &Boundary,
     b: Block,
     stack: &mut Vec<u32>,
     out: &mut Outcome,
 ) {
-    let grid = &field.grid;
+    let grid = field.grid;
     let single = (0..3).all(|a| b.hi[a] - b.lo[a] == 1);
     if single {
         out.leaves.push(b.lo.map(|v| v as u32));
