@@ -8,7 +8,7 @@
 //! [`super::tree`]).
 
 use super::exact::solid_angle;
-use super::expansion::FarField;
+use super::expansion::{FarField, FarPoly};
 use super::tree::WindingTree;
 use crate::primitives::{PrimitiveSet, Triangle};
 use glam::DVec3;
@@ -81,6 +81,7 @@ pub fn winding_numbers(
             for k in idx.len()..GROUP {
                 lanes.set(k, points[idx[0] as usize]);
             }
+            lanes.relative();
             group(tree, set, beta, &mut lanes, idx.len(), scratch);
             lanes.acc
         })
@@ -99,6 +100,11 @@ struct Lanes {
     x: [f64; GROUP],
     y: [f64; GROUP],
     z: [f64; GROUP],
+    /// The queries about `origin` (the first one) in f32, for [`far_lanes32`].
+    origin: DVec3,
+    fx: [f32; GROUP],
+    fy: [f32; GROUP],
+    fz: [f32; GROUP],
     acc: [f64; GROUP],
 }
 
@@ -108,6 +114,10 @@ impl Default for Lanes {
             x: [0.0; GROUP],
             y: [0.0; GROUP],
             z: [0.0; GROUP],
+            origin: DVec3::ZERO,
+            fx: [0.0; GROUP],
+            fy: [0.0; GROUP],
+            fz: [0.0; GROUP],
             acc: [0.0; GROUP],
         }
     }
@@ -119,6 +129,14 @@ impl Lanes {
     }
     fn get(&self, k: usize) -> DVec3 {
         DVec3::new(self.x[k], self.y[k], self.z[k])
+    }
+    /// Sets the f32 copies about the first query.
+    fn relative(&mut self) {
+        self.origin = self.get(0);
+        for k in 0..GROUP {
+            let r = self.get(k) - self.origin;
+            (self.fx[k], self.fy[k], self.fz[k]) = (r.x as f32, r.y as f32, r.z as f32);
+        }
     }
 }
 
@@ -161,55 +179,158 @@ fn group(
         }
     }
     far_all(tree, &s.far, lanes);
+    near_all(tree, set, beta2, &s.near, lanes, used);
+}
 
-    for k in 0..used {
-        let q = lanes.get(k);
-        let mut w = 0.0;
-        let mut angles = 0.0;
-        for &i in &s.near {
-            let f = &tree.far[i as usize];
-            let r = f.centre() - q;
-            let d2 = r.length_squared();
-            if (f.r2 as f64) < beta2 * d2 {
-                w += f.eval(r, d2);
-            } else {
-                let node = &nodes[i as usize];
-                let first = node.index as usize;
-                for t in &set.prims[first..first + node.count as usize] {
-                    angles += solid_angle(q, t.a.as_dvec3(), t.b.as_dvec3(), t.c.as_dvec3());
-                }
+/// The leaves near the group's box: each lane takes a leaf's far field where the
+/// criterion holds for its own query (all lanes at once, as [`far_lanes`] with a mask),
+/// and the exact solid angles of its triangles where it does not.
+fn near_all(
+    tree: &WindingTree,
+    set: &PrimitiveSet<Triangle>,
+    beta2: f64,
+    list: &[u32],
+    lanes: &mut Lanes,
+    used: usize,
+) {
+    let nodes = &set.bvh.nodes;
+    let mut exact = [false; GROUP];
+    let mut angles = [0.0f64; GROUP];
+    for &i in list {
+        let f = &tree.far[i as usize];
+        if !far_lanes_where(f, lanes, beta2, &mut exact) {
+            continue;
+        }
+        let node = &nodes[i as usize];
+        let first = node.index as usize;
+        let tris = &set.prims[first..first + node.count as usize];
+        for k in (0..used).filter(|&k| exact[k]) {
+            let q = lanes.get(k);
+            for t in tris {
+                angles[k] += solid_angle(q, t.a.as_dvec3(), t.b.as_dvec3(), t.c.as_dvec3());
             }
         }
-        lanes.acc[k] += w + angles / (4.0 * PI);
+    }
+    for k in 0..used {
+        lanes.acc[k] += angles[k] / (4.0 * PI);
     }
 }
 
-/// Adds the far fields `list` at every lane's query: with AVX2 and FMA when the
-/// processor has them (checked once at run time), else with the baseline instructions.
-fn far_all(tree: &WindingTree, list: &[u32], lanes: &mut Lanes) {
+/// [`far_lanes`] for the lanes whose own query meets the far-field criterion; marks
+/// the others in `exact` and says whether there are any.
+fn far_lanes_where(f: &FarField, lanes: &mut Lanes, beta2: f64, exact: &mut [bool; GROUP]) -> bool {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the processor supports the features the function is compiled for.
-        unsafe { far_all_avx2(tree, list, lanes) };
-        return;
+        return unsafe { far_lanes_where_avx2(f, lanes, beta2, exact) };
     }
+    far_lanes_masked(f, lanes, beta2, exact)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn far_lanes_where_avx2(
+    f: &FarField,
+    lanes: &mut Lanes,
+    beta2: f64,
+    exact: &mut [bool; GROUP],
+) -> bool {
+    far_lanes_masked(f, lanes, beta2, exact)
+}
+
+/// Adds the far fields `list` at every lane's query, in f32 ([`far_lanes32`]): with AVX2
+/// and FMA when the processor has them (checked once at run time), else with the
+/// baseline instructions.
+fn far_all(tree: &WindingTree, list: &[u32], lanes: &mut Lanes) {
+    let mut acc = [0.0f32; GROUP];
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the processor supports the features the function is compiled for.
+        unsafe { far_all_avx2(tree, list, lanes, &mut acc) };
+    } else {
+        far_all_base(tree, list, lanes, &mut acc);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    far_all_base(tree, list, lanes, &mut acc);
+    for (a, &v) in lanes.acc.iter_mut().zip(&acc) {
+        *a += v as f64;
+    }
+}
+
+fn far_all_base(tree: &WindingTree, list: &[u32], lanes: &Lanes, acc: &mut [f32; GROUP]) {
     for &i in list {
-        far_lanes(&tree.far[i as usize], lanes);
+        far_lanes32::<false>(&tree.far[i as usize], &tree.poly[i as usize], lanes, acc);
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn far_all_avx2(tree: &WindingTree, list: &[u32], lanes: &mut Lanes) {
+fn far_all_avx2(tree: &WindingTree, list: &[u32], lanes: &Lanes, acc: &mut [f32; GROUP]) {
     for &i in list {
-        far_lanes(&tree.far[i as usize], lanes);
+        far_lanes32::<true>(&tree.far[i as usize], &tree.poly[i as usize], lanes, acc);
     }
 }
 
-/// Adds the far field `f` at every lane's query ([`FarField::eval`], written over the
-/// lanes for the vectorizer).
+/// `a b + c`, fused when `FMA`.
 #[inline(always)]
-fn far_lanes(f: &FarField, lanes: &mut Lanes) {
+fn fma<const FMA: bool>(a: f32, b: f32, c: f32) -> f32 {
+    if FMA { a.mul_add(b, c) } else { a * b + c }
+}
+
+/// Adds the far field `f` (as the polynomials `p`) at every lane's query to `acc`, in
+/// f32 about the lanes' origin (so the precision is that of the distances, not of the
+/// coordinates).
+#[inline(always)]
+fn far_lanes32<const FMA: bool>(f: &FarField, p: &FarPoly, lanes: &Lanes, acc: &mut [f32; GROUP]) {
+    let c = f.centre() - lanes.origin;
+    let c = [c.x as f32, c.y as f32, c.z as f32];
+    let scale = (1.0 / (4.0 * PI)) as f32;
+    let fm = fma::<FMA>;
+    for k in 0..GROUP {
+        let (rx, ry, rz) = (c[0] - lanes.fx[k], c[1] - lanes.fy[k], c[2] - lanes.fz[k]);
+        let d2 = fm(rx, rx, fm(ry, ry, rz * rz)).max(f32::MIN_POSITIVE);
+        let s = 1.0 / d2.sqrt();
+        let (x, y, z) = (rx * s, ry * s, rz * s);
+        let (xx, xy, xz, yy, yz, zz) = (x * x, x * y, x * z, y * y, y * z, z * z);
+        let order0 = fm(p.n[0], x, fm(p.n[1], y, p.n[2] * z));
+        let a = &p.a;
+        let order1 = fm(
+            a[0],
+            xx,
+            fm(
+                a[1],
+                xy,
+                fm(a[2], xz, fm(a[3], yy, fm(a[4], yz, fm(a[5], zz, p.trace)))),
+            ),
+        );
+        let c = &p.cubic;
+        let qx = fm(
+            c[0],
+            xx,
+            fm(
+                c[1],
+                xy,
+                fm(c[2], xz, fm(c[3], yy, fm(c[4], yz, c[5] * zz))),
+            ),
+        );
+        let qy = fm(c[6], yy, fm(c[7], yz, c[8] * zz));
+        let cubic = fm(x, qx, fm(y, qy, c[9] * zz * z));
+        let order2 = fm(p.g[0], x, fm(p.g[1], y, fm(p.g[2], z, cubic)));
+        acc[k] = fm(s * s * scale, fm(s, fm(s, order2, order1), order0), acc[k]);
+    }
+}
+
+/// Adds the far field `f` ([`FarField::eval`], in f64, written over the lanes for the
+/// vectorizer) at the lanes whose query meets `r2 < beta2 d2`, marks the others in
+/// `exact`, and says whether it marked any.
+#[inline(always)]
+fn far_lanes_masked(
+    f: &FarField,
+    lanes: &mut Lanes,
+    beta2: f64,
+    exact: &mut [bool; GROUP],
+) -> bool {
+    let r2 = f.r2 as f64;
     let g = |x: f32| x as f64;
     let (cx, cy, cz) = (g(f.centre[0]), g(f.centre[1]), g(f.centre[2]));
     let (nx, ny, nz) = (g(f.n[0]), g(f.n[1]), g(f.n[2]));
@@ -251,8 +372,12 @@ fn far_lanes(f: &FarField, lanes: &mut Lanes) {
         let sum_iik = a0 + b1 + c2;
         let sum_diag = rx * tdiag[0] + ry * tdiag[1] + rz * tdiag[2];
         let order2 = 0.5 * (15.0 * cubic * inv7 - 3.0 * (2.0 * sum_iik + sum_diag) * inv5);
-        lanes.acc[k] += (order0 * inv3 + order1 + order2) * scale;
+        let v = (order0 * inv3 + order1 + order2) * scale;
+        let far = r2 < beta2 * d2;
+        exact[k] = !far;
+        lanes.acc[k] += if far { v } else { 0.0 };
     }
+    exact.iter().any(|&e| e)
 }
 
 /// The indices of `points` sorted along a Morton curve over their bounding box.

@@ -15,7 +15,7 @@
 //! counts, however far.
 
 use super::exact::solid_angle;
-use super::expansion::{FarField, Moments};
+use super::expansion::{FarField, FarPoly, Moments};
 use crate::bvh::Node;
 use crate::primitives::{PrimitiveSet, Triangle};
 use glam::DVec3;
@@ -25,6 +25,8 @@ use std::f64::consts::PI;
 #[derive(Clone, Debug, Default)]
 pub struct WindingTree {
     pub far: Vec<FarField>,
+    /// The same far fields as polynomials for batch queries (`super::batch`).
+    pub poly: Vec<FarPoly>,
 }
 
 impl WindingTree {
@@ -74,12 +76,13 @@ impl WindingTree {
                 .fold(0.0f64, f64::max);
             f.r2 = grow(r2) as f32;
         });
-        WindingTree { far }
+        let poly = far.iter().map(FarPoly::new).collect();
+        WindingTree { far, poly }
     }
 
     /// Heap memory, bytes.
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of_val(self.far.as_slice())
+        std::mem::size_of_val(self.far.as_slice()) + std::mem::size_of_val(self.poly.as_slice())
     }
 
     /// The winding number of `set` (the set this tree was built from) at `q`, with the
