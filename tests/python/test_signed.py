@@ -83,3 +83,16 @@ def test_bad_arguments_are_named(mesh):
         st.signed_distance(V, F, [[np.nan, 0, 0]])
     with pytest.raises(ValueError, match=r"threads must be in"):
         st.winding_number(V, F, P, threads=-2)
+
+
+@pytest.mark.parametrize("bad", [np.inf, -np.inf, np.nan])
+def test_non_finite_query_points_are_refused_everywhere(mesh, bad):
+    V, F = mesh
+    P = np.array([[0.0, 0.0, 0.0], [0.0, bad, 0.0]])
+    sd = st.SmoothDistance(V, faces=F, alpha=1.0)
+    for call in (sd.value, sd.value_and_gradient, sd.nearest):
+        with pytest.raises(ValueError, match=r"points\[1\] has a non-finite coordinate"):
+            call(P)
+    for call in (st.winding_number, st.signed_distance):
+        with pytest.raises(ValueError, match=r"P\[1\] has a non-finite coordinate"):
+            call(V, F, P)
