@@ -211,8 +211,8 @@ fn near_all(
             }
         }
     }
-    for k in 0..used {
-        lanes.acc[k] += angles[k] / (4.0 * PI);
+    for (a, angle) in lanes.acc.iter_mut().zip(&angles).take(used) {
+        *a += angle / (4.0 * PI);
     }
 }
 
@@ -280,6 +280,8 @@ fn fma<const FMA: bool>(a: f32, b: f32, c: f32) -> f32 {
 /// Adds the far field `f` (as the polynomials `p`) at every lane's query to `acc`, in
 /// f32 about the lanes' origin (so the precision is that of the distances, not of the
 /// coordinates).
+// One index over the lanes' arrays is the form the vectorizer takes.
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 fn far_lanes32<const FMA: bool>(f: &FarField, p: &FarPoly, lanes: &Lanes, acc: &mut [f32; GROUP]) {
     let c = f.centre() - lanes.origin;
@@ -323,6 +325,8 @@ fn far_lanes32<const FMA: bool>(f: &FarField, p: &FarPoly, lanes: &Lanes, acc: &
 /// Adds the far field `f` ([`FarField::eval`], in f64, written over the lanes for the
 /// vectorizer) at the lanes whose query meets `r2 < beta2 d2`, marks the others in
 /// `exact`, and says whether it marked any.
+// One index over the lanes' arrays is the form the vectorizer takes.
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 fn far_lanes_masked(
     f: &FarField,

@@ -46,6 +46,8 @@ pub struct Moments {
 
 impl Moments {
     /// The moments of triangle `(a, b, c)` about `centre`.
+    // Tensor indices read as the formulas in the module docs.
+    #[allow(clippy::needless_range_loop)]
     pub fn triangle(a: DVec3, b: DVec3, c: DVec3, centre: DVec3) -> Moments {
         let an = 0.5 * (b - a).cross(c - a);
         let area = an.length();
@@ -401,6 +403,7 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::needless_range_loop)]
     fn the_second_moment_of_a_triangle_matches_quadrature() {
         let (a, b, c) = (
             DVec3::new(0.2, 0.1, -0.3),
