@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{bumpy_sphere, data_file};
+use common::{bumpy_sphere, data_file, obj_text, run_cli};
 use serde_json::Value;
 use smoothtrace::field::sign::{SignedPlan, sign_field};
 use smoothtrace::field::zarr::ZarrArray;
@@ -111,11 +111,8 @@ fn smooth_plans_have_no_sign() {
 
 /// Runs the built binary with `args` in `dir`, returning (status code, stderr).
 fn smoothtrace(dir: &std::path::Path, args: &[&str]) -> (i32, String) {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_smoothtrace"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("cannot run smoothtrace");
+    let cmd = std::process::Command::new(env!("CARGO_BIN_EXE_smoothtrace"));
+    let out = run_cli(cmd, args, dir, None);
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stderr).into_owned(),
@@ -126,15 +123,7 @@ fn smoothtrace(dir: &std::path::Path, args: &[&str]) -> (i32, String) {
 fn cli_writes_signed_zarr_equal_to_the_npy() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let m = bumpy_sphere(12, 20);
-    let mut obj = String::new();
-    for v in &m.vertices {
-        obj += &format!("v {} {} {}\n", v.x, v.y, v.z);
-    }
-    for t in &m.triangles {
-        obj += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
-    }
-    std::fs::write(d.join("s.obj"), obj).unwrap();
+    std::fs::write(d.join("s.obj"), obj_text(&bumpy_sphere(12, 20))).unwrap();
     let run = |extra: &[&str]| {
         let mut args = vec![
             "field",

@@ -17,7 +17,7 @@ pub fn mesh_from_arrays(
     names: [&str; 3],
 ) -> Result<Mesh, InputError> {
     let [vname, tname, sname] = names;
-    let points = points_from_array(vertices, vname)?;
+    let points = finite_points(vertices, vname)?;
     if points.is_empty() {
         return Err(InputError::Empty(vname.to_string()));
     }
@@ -46,6 +46,27 @@ pub fn mesh_from_arrays(
 /// f64 squared distances overflow (issue 32: `[1e200, 0, 0]` gave `inf`, a zero gradient
 /// and a NaN closest point).
 pub fn points_from_array(values: &[f64], name: &str) -> Result<Vec<DVec3>, InputError> {
+    let points = finite_points(values, name)?;
+    for (row, p) in points.iter().enumerate() {
+        if let Some(problem) = p
+            .to_array()
+            .iter()
+            .find_map(|&v| crate::limits::query_coordinate_problem(v))
+        {
+            return Err(InputError::QueryOutOfRange {
+                array: name.to_string(),
+                row,
+                value: p.to_array(),
+                problem,
+            });
+        }
+    }
+    Ok(points)
+}
+
+/// Points from a flat `(n, 3)` array with finite coordinates (vertices: their own
+/// range check is the f32 one of [`mesh_from_arrays`]).
+fn finite_points(values: &[f64], name: &str) -> Result<Vec<DVec3>, InputError> {
     if !values.len().is_multiple_of(3) {
         return Err(InputError::Shape {
             array: name.to_string(),
@@ -58,24 +79,14 @@ pub fn points_from_array(values: &[f64], name: &str) -> Result<Vec<DVec3>, Input
         .enumerate()
         .map(|(row, c)| {
             let p = DVec3::new(c[0], c[1], c[2]);
-            if !p.is_finite() {
-                return Err(InputError::NonFinite {
+            if p.is_finite() {
+                Ok(p)
+            } else {
+                Err(InputError::NonFinite {
                     array: name.to_string(),
                     row,
                     value: p.to_array(),
-                });
-            }
-            match c
-                .iter()
-                .find_map(|&v| crate::limits::query_coordinate_problem(v))
-            {
-                Some(problem) => Err(InputError::QueryOutOfRange {
-                    array: name.to_string(),
-                    row,
-                    value: p.to_array(),
-                    problem,
-                }),
-                None => Ok(p),
+                })
             }
         })
         .collect()
