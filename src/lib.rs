@@ -33,3 +33,4 @@ pub mod reports;
 pub mod rgb;
 pub mod scene;
 pub mod serve;
+pub mod winding;

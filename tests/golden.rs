@@ -152,6 +152,13 @@ fn golden_bucky_ball() {
     check("bucky_ball.toml");
 }
 
+/// Signed offset surfaces of a closed triangle mesh (issue 32): one inside the solid,
+/// one outside.
+#[test]
+fn golden_signed_torus_offsets() {
+    check("signed_torus.toml");
+}
+
 /// Colour from the data (issue 11 item 6): per-vertex PLY colours through the smooth
 /// colour field, shaded by the MatCap.
 #[test]

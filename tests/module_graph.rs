@@ -34,7 +34,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("primitives", &["primitives"]),
     ("loader", &["load"]),
     ("colour from the data", &["colour"]),
-    ("evaluation", &["eval", "field"]),
+    ("evaluation", &["eval", "winding", "field"]),
     ("camera and film", &["camera", "matcap", "film", "framing"]),
     ("scenes", &["scene"]),
     ("render", &["render"]),

@@ -11,6 +11,7 @@ mod errors;
 mod field;
 mod mesh;
 mod render;
+mod signed;
 mod smooth;
 
 use pyo3::prelude::*;
@@ -24,6 +25,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(field::distance_field, m)?)?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
     m.add_function(wrap_pyfunction!(render::render_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(signed::winding_number, m)?)?;
+    m.add_function(wrap_pyfunction!(signed::signed_distance, m)?)?;
     m.add_function(wrap_pyfunction!(errors::panic_for_tests, m)?)?;
     Ok(())
 }

@@ -17,7 +17,7 @@ pub fn mesh_from_arrays(
     names: [&str; 3],
 ) -> Result<Mesh, InputError> {
     let [vname, tname, sname] = names;
-    let points = points_from_array(vertices, vname)?;
+    let points = finite_points(vertices, vname)?;
     if points.is_empty() {
         return Err(InputError::Empty(vname.to_string()));
     }
@@ -41,8 +41,32 @@ pub fn mesh_from_arrays(
     })
 }
 
-/// Points from a flat `(n, 3)` array; every coordinate must be finite.
+/// Query points from a flat `(n, 3)` array; every coordinate must be finite and within
+/// the command line's query limit ([`crate::limits::MAX_QUERY_COORD`]): beyond it the
+/// f64 squared distances overflow (issue 32: `[1e200, 0, 0]` gave `inf`, a zero gradient
+/// and a NaN closest point).
 pub fn points_from_array(values: &[f64], name: &str) -> Result<Vec<DVec3>, InputError> {
+    let points = finite_points(values, name)?;
+    for (row, p) in points.iter().enumerate() {
+        if let Some(problem) = p
+            .to_array()
+            .iter()
+            .find_map(|&v| crate::limits::query_coordinate_problem(v))
+        {
+            return Err(InputError::QueryOutOfRange {
+                array: name.to_string(),
+                row,
+                value: p.to_array(),
+                problem,
+            });
+        }
+    }
+    Ok(points)
+}
+
+/// Points from a flat `(n, 3)` array with finite coordinates (vertices: their own
+/// range check is the f32 one of [`mesh_from_arrays`]).
+fn finite_points(values: &[f64], name: &str) -> Result<Vec<DVec3>, InputError> {
     if !values.len().is_multiple_of(3) {
         return Err(InputError::Shape {
             array: name.to_string(),
@@ -151,5 +175,18 @@ mod tests {
         );
         let e = mesh_from_arrays(&[], &[], &[], NAMES).unwrap_err();
         assert_eq!(e.to_string(), "V has no vertices");
+    }
+
+    #[test]
+    fn query_points_beyond_the_command_lines_limit_are_refused() {
+        // Issue 32: [1e200, 0, 0] gave inf, a zero gradient, a NaN closest point.
+        let e = points_from_array(&[0.0, 0.0, 0.0, 1e200, 0.0, 0.0], "P").unwrap_err();
+        let m = e.to_string();
+        assert!(
+            m.starts_with("P[1] = [1e200, 0.0, 0.0]: query coordinate 1e200 is beyond"),
+            "{m}"
+        );
+        assert!(points_from_array(&[-1e31, 5e30, 0.0], "P").is_ok());
+        assert!(points_from_array(&[0.0, 2e31, 0.0], "P").is_err());
     }
 }

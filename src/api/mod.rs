@@ -9,6 +9,8 @@
 //! - [`queries`]: a [`TraceObject`](crate::render::TraceObject) (primitive sets plus
 //!   evaluation parameters) from a mesh, and batch queries over many points (smooth
 //!   distance, gradient, nearest primitive), in parallel with rayon.
+//! - [`signed`]: winding numbers and signed distances of a triangle soup
+//!   ([`crate::winding`]), many points at once.
 //! - [`view`]: a default camera that frames an object, and rendering of in-memory objects
 //!   through [`crate::render::pipeline::render_built`].
 //!
@@ -18,6 +20,7 @@
 pub mod arrays;
 pub mod params;
 pub mod queries;
+pub mod signed;
 pub mod view;
 
 /// Bad input given as arrays or parameters (not files). The messages name the array or
@@ -37,6 +40,13 @@ pub enum InputError {
         array: String,
         row: usize,
         value: [f64; 3],
+    },
+    #[error("{array}[{row}] = {value:?}: query coordinate {problem}")]
+    QueryOutOfRange {
+        array: String,
+        row: usize,
+        value: [f64; 3],
+        problem: String,
     },
     #[error(
         "{array}[{row}] holds vertex index {index}, out of range (there are {count} vertices, indices 0..{count})"

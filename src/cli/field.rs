@@ -71,6 +71,14 @@ pub struct FieldArgs {
     /// Barnes-Hut opening parameter in [0, 1].
     #[arg(long, requires = "smooth", default_value_t = 0.5)]
     beta: f64,
+    /// Signed distances: negative inside the solid (fast winding number of the
+    /// triangles above 1/2, evaluated only where the sign can change). Needs
+    /// `--primitive triangles`.
+    #[arg(long, conflicts_with = "smooth")]
+    signed: bool,
+    /// Far-field parameter of the fast winding number, in [0, 1) (0 = exact sum).
+    #[arg(long, requires = "signed", default_value_t = smoothtrace::winding::DEFAULT_BETA)]
+    winding_beta: f64,
     /// Output `.npy` file, or a `.zarr` folder: a chunked Zarr v3 array written chunk by
     /// chunk, so the volume need not fit in memory.
     #[arg(long, short)]
@@ -115,6 +123,14 @@ pub fn run(a: FieldArgs) -> Result<()> {
     }
     if let Some(p) = &a.preview {
         Output::check(p, IMAGE_8BIT, "the preview")?;
+    }
+    if a.signed {
+        if a.primitive != PrimitiveKind::Triangles {
+            bail!(
+                "--signed takes the sign from the triangles' winding number; use --primitive triangles"
+            );
+        }
+        smoothtrace::api::signed::check_beta("--winding-beta", a.winding_beta)?;
     }
     let (mesh, origin) = smoothtrace::load::load_with_origin(&a.mesh, &[a.primitive])?;
     if origin != DVec3::ZERO {
@@ -188,7 +204,7 @@ pub fn run(a: FieldArgs) -> Result<()> {
     if chunked {
         return zarr::run(&a, &mesh, &grid, method, &options);
     }
-    let (f, s) = field::compute(&mesh, a.primitive, &grid, method, &options)?;
+    let (mut f, s) = field::compute(&mesh, a.primitive, &grid, method, &options)?;
     let mut line = format!(
         "  {}: {:.3} s ({:.2} M voxels/s), setup {:.3} s",
         s.method,
@@ -212,6 +228,23 @@ pub fn run(a: FieldArgs) -> Result<()> {
         line += &format!(", {} primitives", s.sites);
     }
     note!("{line}");
+    if a.signed {
+        let st = field::sign::sign_field(&mesh, &mut f, a.winding_beta)?;
+        note!(
+            "  signed: {:.3} s (setup {:.3} s), {} block and {} voxel winding numbers ({:.2}% of the voxels), {} voxels inside{}",
+            st.seconds,
+            st.setup_seconds,
+            st.block_evaluations,
+            st.voxel_evaluations,
+            100.0 * (st.block_evaluations + st.voxel_evaluations) as f64 / grid.len().max(1) as f64,
+            st.inside,
+            if st.boundary_edges == 0 {
+                ", closed mesh".to_string()
+            } else {
+                format!(", open mesh ({} boundary edges)", st.boundary_edges)
+            }
+        );
+    }
     if let Some(b) = a.band {
         let inside = f.values.iter().filter(|v| v.is_finite()).count();
         note!("  band {b}: {inside} voxels within it, the others hold +inf");

@@ -49,6 +49,14 @@ pub struct QueryArgs {
     /// Use the paper's naive (unshifted) accumulation; prints inf where it underflows.
     #[arg(long)]
     naive: bool,
+    /// Signed exact distance: the fifth column is negative inside the solid (fast
+    /// winding number of the mesh's triangles above 1/2) and a seventh column holds the
+    /// winding number.
+    #[arg(long)]
+    signed: bool,
+    /// Far-field parameter of the fast winding number, in [0, 1) (0 = exact sum).
+    #[arg(long, requires = "signed", default_value_t = smoothtrace::winding::DEFAULT_BETA)]
+    winding_beta: f64,
     /// File of whitespace-separated `x y z` lines (default: standard input).
     #[arg(long)]
     points: Option<PathBuf>,
@@ -92,27 +100,41 @@ pub fn run(a: QueryArgs) -> Result<()> {
         a.beta,
         if a.naive { "naive" } else { "stable" },
     );
+    let solid = if a.signed {
+        let beta = smoothtrace::api::signed::check_beta("--winding-beta", a.winding_beta)?;
+        Some(
+            smoothtrace::winding::Solid::from_mesh(&mesh, beta)
+                .context("--signed needs the mesh's triangles")?,
+        )
+    } else {
+        None
+    };
     let queries: Vec<DVec3> = read_points(a.points.as_ref())?
         .into_iter()
         .map(|x| x - origin)
         .collect();
     let set_refs: Vec<&AnySet> = sets.iter().collect();
+    let winding = solid
+        .as_ref()
+        .map(|s| smoothtrace::api::signed::winding_numbers(s, &queries));
     let results: Vec<String> = {
         use rayon::prelude::*;
         queries
             .par_iter()
-            .map(|&x| {
+            .enumerate()
+            .map(|(i, &x)| {
                 let s = eval::evaluate(&set_refs, x, &params);
                 let d = eval::nearest(&set_refs, x).d;
-                format!(
-                    "{} {} {} {} {} {}",
-                    s.s,
-                    s.grad.x,
-                    s.grad.y,
-                    s.grad.z,
-                    d,
-                    s.stats.leaves()
-                )
+                let line = format!("{} {} {} {}", s.s, s.grad.x, s.grad.y, s.grad.z);
+                match &winding {
+                    None => format!("{line} {d} {}", s.stats.leaves()),
+                    Some(w) => format!(
+                        "{line} {} {} {}",
+                        smoothtrace::winding::sign(w[i]) * d,
+                        s.stats.leaves(),
+                        w[i]
+                    ),
+                }
             })
             .collect()
     };

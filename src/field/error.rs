@@ -52,6 +52,8 @@ pub enum FieldError {
     },
     #[error("smooth distance: {0}")]
     BadSmoothParameters(String),
+    #[error("signed volumes hold exact distances; the smooth distance has no sign (drop --smooth)")]
+    SmoothNotSigned,
     #[error(transparent)]
     Primitive(#[from] PrimitiveError),
     #[error(transparent)]

@@ -36,6 +36,10 @@
 //! all others `+inf` (f32 `INFINITY`, also in the `.npy`); every linfac domain is cut to
 //! the band (exactly, row by row), and the BVH query is bounded by it.
 //!
+//! Signed volumes ([`sign::sign_field`], issue 32): the exact distance negated inside
+//! the solid (winding number above 1/2), the winding number evaluated only in blocks of
+//! voxels where the sign can change.
+//!
 //! Boxes and chunks: [`FieldPlan`] prepares a field once (sites, BVH) and computes any
 //! box of voxels of its grid ([`FieldSource`], `plan.rs`); [`zarr`] writes a volume as a
 //! chunked Zarr v3 array one row of chunks at a time, so its memory is that of a row,
@@ -54,6 +58,7 @@ mod linfac;
 mod output;
 mod plan;
 mod reference;
+pub mod sign;
 mod sites;
 mod volume;
 pub mod zarr;

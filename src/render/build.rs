@@ -4,6 +4,7 @@
 //! `--verbose` can show what was built.
 
 use super::object::TraceObject;
+use super::signed::SignedSurface;
 use crate::camera::{Camera, CameraError};
 use crate::colour::by_geometry::height_colours;
 use crate::colour::{GeometryColorBy, ObjectColours, SetColours};
@@ -12,7 +13,8 @@ use crate::matcap::{MatCap, MatCapError};
 use crate::mesh::{Aabb, Mesh, MeshError};
 use crate::primitives::{AnySet, PrimitiveError};
 use crate::procedural::GeneratorError;
-use crate::scene::{Geometry, Scene};
+use crate::scene::{Geometry, Scene, Surface};
+use crate::winding::boundary::Boundary;
 use std::time::Instant;
 
 /// Why a scene could not be built.
@@ -195,6 +197,12 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
             });
             c
         });
+        let signed = match obj.surface {
+            Surface::Smooth => None,
+            Surface::Signed { offset } => {
+                Some(signed_surface(&name, k, &mesh, offset, &mut steps)?)
+            }
+        };
         drop(mesh);
         let params = EvalParams {
             accumulation: scene.render.evaluation,
@@ -210,6 +218,7 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
             seconds: 0.0,
         });
         let mut object = TraceObject::new(sets, params);
+        object.signed = signed;
         object.colours = match obj.colour {
             Some(c) if c.by == GeometryColorBy::Normal => Some(ObjectColours {
                 sets: Vec::new(),
@@ -264,6 +273,42 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
         steps,
         diagonals,
     })
+}
+
+/// The signed offset surface of object `k` (`surface = "signed"`): its mesh must be
+/// closed (no boundary edges), else the winding number's crossing of 1/2 away from the
+/// mesh would draw a false sheet (`render::signed`).
+fn signed_surface(
+    scene: &str,
+    k: usize,
+    mesh: &Mesh,
+    offset: f64,
+    steps: &mut Vec<BuildStep>,
+) -> Result<SignedSurface, BuildError> {
+    let t = Instant::now();
+    let boundary = Boundary::of(mesh);
+    if boundary.edges > 0 {
+        return Err(BuildError::Invalid {
+            scene: scene.to_string(),
+            object: k,
+            message: format!(
+                "surface = \"signed\" needs a closed triangle mesh, and {} has {} boundary \
+                 edges (holes or open borders); close them, or draw the smooth surface",
+                mesh.name, boundary.edges
+            ),
+        });
+    }
+    let surface = SignedSurface::new(mesh, offset).map_err(|source| BuildError::Primitives {
+        scene: scene.to_string(),
+        object: k,
+        source,
+    })?;
+    steps.push(BuildStep {
+        object: k,
+        what: format!("signed surface at offset {offset}: winding-number far fields"),
+        seconds: t.elapsed().as_secs_f64(),
+    });
+    Ok(surface)
 }
 
 /// Object `k`'s alpha and max_alpha in 1/world units, resolved against `diag` (its

@@ -5,6 +5,7 @@ pub mod cone;
 pub mod neighbours;
 pub mod object;
 pub mod options;
+pub mod signed;
 pub mod step_beta;
 mod stepper;
 pub mod tracer;

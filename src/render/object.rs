@@ -1,6 +1,7 @@
 //! A traceable object: one or more primitive sets summed into one smooth distance
 //! (SPEC 2), with its evaluation parameters and the bound of where its surface can be.
 
+use super::signed::SignedSurface;
 use crate::colour::ObjectColours;
 use crate::eval::{self, Along, EvalParams, Sample};
 use crate::mesh::Aabb;
@@ -16,6 +17,9 @@ pub struct TraceObject {
     /// Colours from the data, one [`crate::colour::SetColours`] per set; `None` shades
     /// with the MatCap alone.
     pub colours: Option<ObjectColours>,
+    /// `surface = "signed"`: the object draws this offset surface of its triangles'
+    /// signed distance instead of its smooth distance's zero set (`render::signed`).
+    pub signed: Option<SignedSurface>,
 }
 
 impl TraceObject {
@@ -26,6 +30,7 @@ impl TraceObject {
             params,
             bounds,
             colours: None,
+            signed: None,
         }
     }
 
@@ -34,10 +39,13 @@ impl TraceObject {
     }
 
     /// How far outside the data's bounding box the zero set can reach at sharpness
-    /// `alpha`: every evaluation (at any beta) satisfies `s(x) >= r(x) - ln(N w_max) /
+    /// `alpha` (a signed surface: its offset, `render::signed`): every evaluation (at any beta) satisfies `s(x) >= r(x) - ln(N w_max) /
     /// alpha` with `r` the distance to the box, because the sum is at most `N w_max
     /// exp(-alpha r)`.
     pub fn reach(&self, alpha: f64) -> f64 {
+        if let Some(signed) = &self.signed {
+            return signed.reach();
+        }
         let n: usize = self.sets.iter().map(|s| s.len()).sum();
         let w_max = self
             .sets
@@ -87,6 +95,9 @@ impl TraceObject {
         bound: bool,
         upper: bool,
     ) -> Sample {
+        if let Some(signed) = &self.signed {
+            return signed.sample(x, grad);
+        }
         let mut p = self.params;
         p.upper_bound = upper;
         p.alpha = alpha;

@@ -15,7 +15,7 @@
 
 use super::{
     AlphaSpec, CameraSettings, Geometry, LasOptions, MatCapSpec, Object, Scene, SceneError,
-    Transform,
+    Surface, Transform,
 };
 use crate::primitives::PrimitiveKind;
 use glam::DVec3;
@@ -109,6 +109,7 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
             },
             las: LasOptions::default(),
             colour: None,
+            surface: Surface::Smooth,
         })
         .collect();
     let mut scene = Scene::new(camera, objects);

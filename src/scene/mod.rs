@@ -145,6 +145,22 @@ pub struct Object {
     /// `color_by = "vertex" | "height" | "normal"` (any object); lidar attributes are in
     /// `las`.
     pub colour: Option<crate::colour::GeometryColouring>,
+    /// Which surface of the object is drawn (`surface = "signed"`, `offset = d`).
+    pub surface: Surface,
+}
+
+/// The surface an object draws: the zero set of its smooth distance (default), or an
+/// offset surface `S = offset` of the signed distance `S` of a closed triangle mesh
+/// (exact distance, negative inside where the winding number exceeds 1/2; issue 32).
+/// Negative offsets lie inside the solid. A signed surface takes no alpha: its `alpha`
+/// is a placeholder the evaluation does not read.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Surface {
+    #[default]
+    Smooth,
+    Signed {
+        offset: f64,
+    },
 }
 
 impl Object {

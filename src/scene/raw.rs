@@ -77,6 +77,9 @@ pub(super) struct RawObject {
     pub origin: Option<Spanned<[f64; 3]>>,
     pub color_by: Option<Spanned<String>>,
     pub colormap: Option<Spanned<String>>,
+    // Signed offset surfaces (issue 32): checked when resolving.
+    pub surface: Option<Spanned<String>>,
+    pub offset: Option<Spanned<f64>>,
 }
 
 /// `crop = { min = [x, y, z], max = [x, y, z] }` in file coordinates.

@@ -8,7 +8,7 @@ use super::raw::{RawCamera, RawImage, RawObject, RawRender, RawScene, RawTransfo
 use super::validate::{max_steps_error, size_error};
 use super::{
     AlphaSpec, CameraSettings, Epsilon, Geometry, ImageSettings, Object, Origins, RenderSettings,
-    Scene, Transform,
+    Scene, Surface, Transform,
 };
 use crate::camera::Camera;
 use crate::film::options::samples_error;
@@ -23,6 +23,7 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 mod lidar;
+mod surface;
 
 /// Parses `text` (the contents of `path`) into an unvalidated scene.
 pub(super) fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
@@ -325,6 +326,7 @@ impl Resolver<'_> {
         let span = raw.span();
         let raw = raw.into_inner();
         let (las, colour) = self.lidar(&name, &raw)?;
+        let surface = self.surface(&name, &raw)?;
         let geometry = match (raw.mesh, raw.generator) {
             (Some(_), Some(g)) => {
                 return Err(self.invalid(
@@ -351,8 +353,12 @@ impl Resolver<'_> {
             (None, Some(g)) => Geometry::Generator(g.into_inner()),
         };
         let primitives = self.primitives(&name, &raw.primitives)?;
+        // A signed surface reads no alpha (`Surface`); the placeholder keeps the checks
+        // of the smooth objects' alphas satisfied.
+        let placeholder = (surface != Surface::Smooth).then_some(AlphaSpec::Relative(1.0));
         let alpha = self
             .alpha(&name, "alpha", raw.alpha, raw.alpha_rel)?
+            .or(placeholder)
             .ok_or_else(|| {
                 self.invalid(
                     span.clone(),
@@ -385,6 +391,7 @@ impl Resolver<'_> {
             matcap,
             las,
             colour,
+            surface,
         })
     }
 

@@ -337,6 +337,7 @@ pub fn scene_for_mesh(path: &Path) -> Result<Scene, crate::mesh::MeshError> {
         matcap: Default::default(),
         las: Default::default(),
         colour: None,
+        surface: crate::scene::Surface::Smooth,
     };
     let mut scene = Scene::new(
         CameraSettings::looking_at(DVec3::Z, DVec3::ZERO),

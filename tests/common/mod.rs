@@ -146,3 +146,15 @@ pub fn run_cli(
     drop(child.stdin.take());
     child.wait_with_output().unwrap()
 }
+
+/// `mesh`'s vertices and triangles as OBJ text.
+pub fn obj_text(mesh: &Mesh) -> String {
+    let mut obj = String::new();
+    for v in &mesh.vertices {
+        obj += &format!("v {} {} {}\n", v.x, v.y, v.z);
+    }
+    for t in &mesh.triangles {
+        obj += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    obj
+}

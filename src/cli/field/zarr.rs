@@ -7,10 +7,13 @@ use crate::cli::console::note;
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
+use smoothtrace::field::sign::SignedPlan;
 use smoothtrace::field::zarr::{
     self as zarr_io, Codec, ZarrArray, ZarrSpec, index_ranges, parse_chunks, write_chunks,
 };
-use smoothtrace::field::{FieldOptions, FieldPlan, Grid, Method, human_bytes, setup_bytes};
+use smoothtrace::field::{
+    FieldOptions, FieldPlan, FieldSource, Grid, Method, human_bytes, setup_bytes,
+};
 use smoothtrace::mesh::Mesh;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -90,8 +93,14 @@ fn field_attributes(
         } => json!({"alpha": alpha, "max_alpha": max_alpha, "beta": beta}),
         _ => serde_json::Value::Null,
     };
+    let kind = match method {
+        Method::Smooth { .. } => "smooth distance",
+        _ if a.signed => "signed distance",
+        _ => "unsigned distance",
+    };
     json!({
-        "kind": if matches!(method, Method::Smooth { .. }) { "smooth distance" } else { "unsigned distance" },
+        "kind": kind,
+        "winding_beta": if a.signed { json!(a.winding_beta) } else { serde_json::Value::Null },
         "method": method.name(),
         "primitive": a.primitive.to_string(),
         "band": options.band,
@@ -168,7 +177,16 @@ pub fn run(
         return report(&array, total, false);
     }
     let plan = FieldPlan::new(mesh, a.primitive, grid, method, options)?;
-    note!("  setup {:.3} s", plan.setup_seconds());
+    // Signed: the same distances, signed box by box from the winding numbers.
+    let (source, setup): (Box<dyn FieldSource>, f64) = if a.signed {
+        let s = SignedPlan::new(plan, mesh, a.winding_beta)?;
+        let t = s.setup_seconds();
+        (Box::new(s), t)
+    } else {
+        let t = plan.setup_seconds();
+        (Box::new(plan), t)
+    };
+    note!("  setup {setup:.3} s");
     let _ = ctrlc::set_handler(|| {
         if STOP.swap(true, Ordering::SeqCst) {
             std::process::exit(130);
@@ -184,8 +202,10 @@ pub fn run(
             .progress_chars("=> "),
     );
     bar.set_message(method.name());
-    let run = write_chunks(&plan, &array, &todo, &STOP, &|n| bar.set_position(n as u64))
-        .context("writing the chunks")?;
+    let run = write_chunks(source.as_ref(), &array, &todo, &STOP, &|n| {
+        bar.set_position(n as u64)
+    })
+    .context("writing the chunks")?;
     bar.finish_and_clear();
     note!(
         "  {}: {} chunks, {} voxels in {:.3} s ({:.2} M voxels/s; computing {:.3} s)",

@@ -1,0 +1,197 @@
+//! The fast winding number on the BVH of a triangle set (Barill et al. 2018, section 3.3):
+//! each node of the set's binary BVH gets the far field of its triangles
+//! ([`super::expansion`]), built bottom-up by shifting the children's moments; a query
+//! walks the tree from the root and decides per node:
+//!
+//! - far field: the node's radius `R` (about its area-weighted centroid `p`) satisfies
+//!   `R < beta |q - p|`; its second-order expansion stands for all of its triangles
+//!   (error of relative order `beta^3`);
+//! - exact: a leaf that is not far: the solid angles of its triangles
+//!   ([`super::exact::solid_angle`]);
+//! - opened: both children are visited.
+//!
+//! `beta = 0` is the exact sum; `beta` is the reciprocal of libigl's `accuracy_scale`
+//! (its default 2 is `beta = 0.5`). Nothing is pruned: every triangle's solid angle
+//! counts, however far.
+
+use super::exact::solid_angle;
+use super::expansion::{FarField, FarPoly, Moments};
+use crate::bvh::Node;
+use crate::primitives::{PrimitiveSet, Triangle};
+use glam::DVec3;
+use std::f64::consts::PI;
+
+/// The far fields of every node of a triangle set's BVH (indexed like `bvh.nodes`).
+#[derive(Clone, Debug, Default)]
+pub struct WindingTree {
+    pub far: Vec<FarField>,
+    /// The same far fields as polynomials for batch queries (`super::batch`).
+    pub poly: Vec<FarPoly>,
+}
+
+impl WindingTree {
+    /// Builds the far fields of `set`'s BVH nodes, children before parents (the
+    /// depth-first layout puts every child after its parent).
+    pub fn build(set: &PrimitiveSet<Triangle>) -> WindingTree {
+        let nodes = &set.bvh.nodes;
+        let mut moments: Vec<Moments> = vec![Moments::default(); nodes.len()];
+        let mut far = vec![FarField::default(); nodes.len()];
+        for i in (0..nodes.len()).rev() {
+            let node = &nodes[i];
+            let (m, r2) = if node.is_leaf() {
+                leaf(set, node)
+            } else {
+                let (l, r) = (&moments[i + 1], &moments[node.index as usize]);
+                let centre = centre_of(l.area_centroid + r.area_centroid, l.area + r.area, node);
+                let mut m = l.shifted(centre);
+                m.add(&r.shifted(centre));
+                // Every triangle lies within a child's radius of its centre, and in the
+                // node's box.
+                let reach =
+                    |k: usize| (far[k].centre() - centre).length() + (far[k].r2 as f64).sqrt();
+                let r = reach(i + 1).max(reach(node.index as usize));
+                (m, r.min(box_reach(node, centre)).powi(2))
+            };
+            far[i] = m.far_field(grow(r2));
+            moments[i] = m;
+        }
+        // The exact radius of each node about its centre (tighter than the children's
+        // reach): every node's triangles are a contiguous range in leaf order.
+        let mut first = vec![0u32; nodes.len()];
+        for i in (0..nodes.len()).rev() {
+            first[i] = if nodes[i].is_leaf() {
+                nodes[i].index
+            } else {
+                first[i + 1]
+            };
+        }
+        use rayon::prelude::*;
+        far.par_iter_mut().enumerate().for_each(|(i, f)| {
+            let c = f.centre();
+            let lo = first[i] as usize;
+            let r2 = set.prims[lo..lo + nodes[i].size as usize]
+                .iter()
+                .flat_map(|t| [t.a, t.b, t.c])
+                .map(|v| (v.as_dvec3() - c).length_squared())
+                .fold(0.0f64, f64::max);
+            f.r2 = grow(r2) as f32;
+        });
+        let poly = far.iter().map(FarPoly::new).collect();
+        WindingTree { far, poly }
+    }
+
+    /// Heap memory, bytes.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(self.far.as_slice()) + std::mem::size_of_val(self.poly.as_slice())
+    }
+
+    /// The winding number of `set` (the set this tree was built from) at `q`, with the
+    /// far-field criterion `beta`; `stack` is scratch space, reused between queries.
+    pub fn winding_number(
+        &self,
+        set: &PrimitiveSet<Triangle>,
+        q: DVec3,
+        beta: f64,
+        stack: &mut Vec<u32>,
+    ) -> f64 {
+        self.winding_number_counted(set, q, beta, stack).0
+    }
+
+    /// [`Self::winding_number`] with the number of far fields and of exact solid angles
+    /// it summed.
+    pub fn winding_number_counted(
+        &self,
+        set: &PrimitiveSet<Triangle>,
+        q: DVec3,
+        beta: f64,
+        stack: &mut Vec<u32>,
+    ) -> (f64, u32, u32) {
+        debug_assert_eq!(self.far.len(), set.bvh.nodes.len());
+        let nodes = &set.bvh.nodes;
+        if nodes.is_empty() {
+            return (0.0, 0, 0);
+        }
+        let (mut fars, mut exacts) = (0u32, 0u32);
+        let beta2 = beta * beta;
+        let mut far_sum = 0.0;
+        let mut angles = 0.0;
+        stack.clear();
+        stack.push(0);
+        while let Some(i) = stack.pop() {
+            let f = &self.far[i as usize];
+            let r = f.centre() - q;
+            let d2 = r.length_squared();
+            if (f.r2 as f64) < beta2 * d2 {
+                far_sum += f.eval(r, d2);
+                fars += 1;
+                continue;
+            }
+            let node = &nodes[i as usize];
+            if node.is_leaf() {
+                let first = node.index as usize;
+                exacts += node.count;
+                for t in &set.prims[first..first + node.count as usize] {
+                    angles += solid_angle(q, t.a.as_dvec3(), t.b.as_dvec3(), t.c.as_dvec3());
+                }
+            } else {
+                stack.push(node.index);
+                stack.push(i + 1);
+            }
+        }
+        (far_sum + angles / (4.0 * PI), fars, exacts)
+    }
+}
+
+/// The moments and squared radius of a leaf's triangles about their area-weighted
+/// centroid (rounded to f32, the precision the far field stores it in).
+fn leaf(set: &PrimitiveSet<Triangle>, node: &Node) -> (Moments, f64) {
+    let first = node.index as usize;
+    let tris = &set.prims[first..first + node.count as usize];
+    let corners = |t: &Triangle| [t.a.as_dvec3(), t.b.as_dvec3(), t.c.as_dvec3()];
+    let mut area = 0.0;
+    let mut area_centroid = DVec3::ZERO;
+    for t in tris {
+        let [a, b, c] = corners(t);
+        let ar = 0.5 * (b - a).cross(c - a).length();
+        area += ar;
+        area_centroid += ar * (a + b + c) / 3.0;
+    }
+    let centre = centre_of(area_centroid, area, node);
+    let mut m = Moments {
+        centre,
+        ..Moments::default()
+    };
+    let mut r2 = 0.0f64;
+    for t in tris {
+        let [a, b, c] = corners(t);
+        m.add(&Moments::triangle(a, b, c, centre));
+        for v in [a, b, c] {
+            r2 = r2.max((v - centre).length_squared());
+        }
+    }
+    (m, r2)
+}
+
+/// The area-weighted centroid (the box centre when the area is 0), rounded to f32.
+fn centre_of(area_centroid: DVec3, area: f64, node: &Node) -> DVec3 {
+    let c = if area > 0.0 {
+        area_centroid / area
+    } else {
+        (node.min.as_dvec3() + node.max.as_dvec3()) / 2.0
+    };
+    c.as_vec3().as_dvec3()
+}
+
+/// Distance from `c` to the farthest corner of the node's box.
+fn box_reach(node: &Node, c: DVec3) -> f64 {
+    let far = (c - node.min.as_dvec3())
+        .abs()
+        .max((node.max.as_dvec3() - c).abs());
+    far.length()
+}
+
+/// A squared radius grown so that its f32 rounding (and the f32 centre) stays an upper
+/// bound.
+fn grow(r2: f64) -> f64 {
+    r2 * (1.0 + 1e-5)
+}
