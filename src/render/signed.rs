@@ -61,6 +61,8 @@ impl SignedSurface {
             underflow: false,
             reach: s,
             reach_back: s,
+            // The distance is exact: nothing to certify (`render::tracer` item 11).
+            s_upper: s,
             stats: EvalStats {
                 nodes: signed.nearest.nodes,
                 exact: 1,

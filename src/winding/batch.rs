@@ -10,6 +10,7 @@
 use super::exact::solid_angle;
 use super::expansion::{FarField, FarPoly};
 use super::tree::WindingTree;
+use crate::geometry::morton::morton_order;
 use crate::primitives::{PrimitiveSet, Triangle};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -382,48 +383,4 @@ fn far_lanes_masked(
         lanes.acc[k] += if far { v } else { 0.0 };
     }
     exact.iter().any(|&e| e)
-}
-
-/// The indices of `points` sorted along a Morton curve over their bounding box.
-pub fn morton_order(points: &[DVec3]) -> Vec<u32> {
-    let (lo, hi) = points
-        .par_iter()
-        .fold(
-            || (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), &p| (lo.min(p), hi.max(p)),
-        )
-        .reduce(
-            || (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |a, b| (a.0.min(b.0), a.1.max(b.1)),
-        );
-    let extent = (hi - lo).max_element();
-    let scale = if extent > 0.0 {
-        1048575.0 / extent
-    } else {
-        0.0
-    };
-    let mut keys: Vec<(u64, u32)> = points
-        .par_iter()
-        .enumerate()
-        .map(|(i, &p)| {
-            let c = ((p - lo) * scale).clamp(DVec3::ZERO, DVec3::splat(1048575.0));
-            (
-                spread(c.x as u64) | (spread(c.y as u64) << 1) | (spread(c.z as u64) << 2),
-                i as u32,
-            )
-        })
-        .collect();
-    keys.par_sort_unstable();
-    keys.into_iter().map(|(_, i)| i).collect()
-}
-
-/// The low 21 bits of `v` spread to every third bit.
-fn spread(v: u64) -> u64 {
-    let mut x = v & 0x1f_ffff;
-    x = (x | (x << 32)) & 0x001f_0000_0000_ffff;
-    x = (x | (x << 16)) & 0x001f_0000_ff00_00ff;
-    x = (x | (x << 8)) & 0x100f_00f0_0f00_f00f;
-    x = (x | (x << 4)) & 0x10c3_0c30_c30c_30c3;
-    x = (x | (x << 2)) & 0x1249_2492_4924_9249;
-    x
 }
