@@ -17,14 +17,9 @@ use smoothtrace::primitives::{AnySet, PrimitiveKind};
 use std::path::PathBuf;
 use std::time::Instant;
 
-fn arg<T: std::str::FromStr>(name: &str, default: T) -> T {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+#[path = "common/args.rs"]
+mod args;
+use args::arg;
 
 /// CPU seconds of this process so far (all threads; user + system), from
 /// `/proc/self/stat`; NaN where that file does not exist.

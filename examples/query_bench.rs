@@ -16,14 +16,9 @@ use smoothtrace::mesh::Mesh;
 use smoothtrace::primitives::PrimitiveKind;
 use std::time::Instant;
 
-fn arg<T: std::str::FromStr>(name: &str, default: T) -> T {
-    let args: Vec<String> = std::env::args().collect();
-    args.iter()
-        .position(|a| a == name)
-        .and_then(|i| args.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+#[path = "common/args.rs"]
+mod args;
+use args::arg;
 
 fn points(mesh: &Mesh, n: usize, near: bool) -> Vec<DVec3> {
     let b = mesh.bounds();
