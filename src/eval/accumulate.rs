@@ -35,13 +35,11 @@ pub struct Accumulator {
     /// Upper bound of the shifted mass of subtrees pruned against the budget (added to
     /// the sum at the end, so `s` stays a lower bound).
     pub pruned: f64,
-    /// When set, `lower` sums the terms that are exact and, for far-field terms (added
-    /// while `far_term` is set), the lower bound of their subtrees (`far_lower`),
-    /// shifted like `s`: `m - ln(lower) / alpha` bounds the exact value from above. (Kept
-    /// apart rather than as `s` minus the far terms: those can exceed the exact sum by
-    /// many orders of magnitude, and the difference would be rounding.)
-    pub track_far: bool,
-    pub far_term: bool,
+    /// The terms added as exact (`add`, `add_value`) and, for far-field terms (`add_far`,
+    /// `add_value_far`), the lower bounds of their subtrees given to `far_lower`, shifted
+    /// like `s`: `m - ln(lower) / alpha` bounds the exact value from above. (Kept apart
+    /// rather than as `s` minus the far terms: those can exceed the exact sum by many
+    /// orders of magnitude, and the difference would be rounding.)
     lower: f64,
 }
 
@@ -56,8 +54,6 @@ impl Accumulator {
             naive_s: 0.0,
             naive_g: DVec3::ZERO,
             pruned: 0.0,
-            track_far: false,
-            far_term: false,
             lower: 0.0,
         }
     }
@@ -82,13 +78,24 @@ impl Accumulator {
     /// Returns the term as added to the shifted sum, `w exp(-alpha (d - m))`.
     #[inline]
     pub fn add(&mut self, d: f64, w: f64, dir: DVec3, grad_w: DVec3) -> f64 {
+        self.push::<true>(d, w, dir, grad_w)
+    }
+
+    /// [`Accumulator::add`] for a far-field term (an upper bound of its subtree's terms).
+    #[inline]
+    pub fn add_far(&mut self, d: f64, w: f64, dir: DVec3) -> f64 {
+        self.push::<false>(d, w, dir, DVec3::ZERO)
+    }
+
+    #[inline]
+    fn push<const EXACT: bool>(&mut self, d: f64, w: f64, dir: DVec3, grad_w: DVec3) -> f64 {
         let inv_alpha = 1.0 / self.alpha;
         self.shift(d);
         let e = (-self.alpha * (d - self.m)).exp();
         let gterm = w * dir - grad_w * inv_alpha;
         self.s += w * e;
         self.g += e * gterm;
-        if self.track_far && !self.far_term {
+        if EXACT {
             self.lower += w * e;
         }
         if self.naive {
@@ -103,10 +110,21 @@ impl Accumulator {
     /// term as added to the shifted sum, `w exp(-alpha (d - m))`.
     #[inline]
     pub fn add_value(&mut self, d: f64, w: f64) -> f64 {
+        self.push_value::<true>(d, w)
+    }
+
+    /// [`Accumulator::add_value`] for a far-field term.
+    #[inline]
+    pub fn add_value_far(&mut self, d: f64, w: f64) -> f64 {
+        self.push_value::<false>(d, w)
+    }
+
+    #[inline]
+    fn push_value<const EXACT: bool>(&mut self, d: f64, w: f64) -> f64 {
         self.shift(d);
         let e = w * (-self.alpha * (d - self.m)).exp();
         self.s += e;
-        if self.track_far && !self.far_term {
+        if EXACT {
             self.lower += e;
         }
         if self.naive {
@@ -115,7 +133,6 @@ impl Accumulator {
         e
     }
 
-    /// The sharpness the terms are summed at.
     /// Records the lower bound `n exp(-alpha d_far)` of a far-field subtree.
     #[inline]
     pub fn far_lower(&mut self, n: f64, d_far: f64) {

@@ -70,6 +70,9 @@ pub(crate) struct Sink<'a, const GRAD: bool, const SLOPE: bool> {
     pub u: DVec3,
     /// Weight of a far-field term per primitive (for its lower bound).
     pub w_ff: f64,
+    /// Far-field terms also give their subtrees' lower bounds to the accumulator
+    /// (`EvalParams::upper_bound`).
+    pub upper: bool,
 }
 
 impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
@@ -107,22 +110,20 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
                 if d > 0.0 { v.dot(u) / d } else { -1.0 }
             })
         };
-        self.acc.far_term = true;
         if GRAD {
             let dir = (x - x.clamp(min, max)) / r;
-            let e = self.acc.add(r, weight, dir, DVec3::ZERO);
+            let e = self.acc.add_far(r, weight, dir);
             if SLOPE {
                 self.add_slope(m, e, dir.dot(self.u).min(slope_other(self.u)));
             }
         } else if SLOPE {
             let a = (x - x.clamp(min, max)).dot(self.u) / r;
-            let e = self.acc.add_value(r, weight);
+            let e = self.acc.add_value_far(r, weight);
             self.add_slope(m, e, a.min(slope_other(self.u)));
         } else {
-            self.acc.add_value(r, weight);
+            self.acc.add_value_far(r, weight);
         }
-        self.acc.far_term = false;
-        if self.acc.track_far {
+        if self.upper {
             // Every primitive below lies in the box (the union of a middle's two), within
             // the distance of its farthest corner, with a weight of at least 1.
             let (lo, hi) = other.map_or((min, max), |(a, b)| (min.min(a), max.max(b)));

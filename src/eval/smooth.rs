@@ -180,7 +180,6 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
 ) -> Sample {
     let u = along.u;
     let mut acc = Accumulator::new(p.alpha, p.accumulation);
-    acc.track_far = p.upper_bound;
     let mut slopes = Slopes::default();
     let mut stats = EvalStats::default();
     let scale = |s: &AnySet| WeightScale::new(s.max_adj(), p.alpha, p.max_alpha);
@@ -199,6 +198,7 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
                 slopes: &mut slopes,
                 u,
                 w_ff: sc.max_weight(),
+                upper: p.upper_bound,
             };
             crate::with_set!(set, s => {
                 Walk::new(s, x, p, &sc, prune_margin, budget, &mut sink, &mut stats, stack).run()
