@@ -70,20 +70,37 @@ pub fn build_object(
     ))
 }
 
+/// Queries per batch along the Morton curve (in [`nearest`] each starts from its
+/// predecessor's answer).
+const BATCH: usize = 64;
+
 /// `f(x)` at every point, evaluated along a Morton curve (neighbouring queries walk the
 /// same parts of the tree one after the other, so its nodes and primitives stay in the
 /// caches), the results in the input order.
-fn in_morton_order<T: Send + Sync + Clone + Default>(
+fn in_morton_order<T: Send + Copy>(
     points: &[DVec3],
-    f: impl Fn(DVec3) -> T + Sync,
+    f: impl Fn(DVec3) -> T + Send + Sync,
+) -> Vec<T> {
+    in_morton_batches(points, BATCH, |batch| {
+        batch.iter().map(|&i| f(points[i as usize])).collect()
+    })
+}
+
+/// `batch(indices)` for consecutive runs of `size` point indices along a Morton curve,
+/// in parallel; its results (one per index) come back in the input order.
+fn in_morton_batches<T: Send + Copy>(
+    points: &[DVec3],
+    size: usize,
+    batch: impl Fn(&[u32]) -> Vec<T> + Send + Sync,
 ) -> Vec<T> {
     let order = morton_order(points);
-    let found: Vec<T> = order.par_iter().map(|&i| f(points[i as usize])).collect();
-    let mut out = vec![T::default(); points.len()];
-    for (&i, v) in order.iter().zip(found) {
-        out[i as usize] = v;
+    let found: Vec<T> = order.par_chunks(size).flat_map_iter(&batch).collect();
+    // The answer to point `i` is `found[rank[i]]`.
+    let mut rank = vec![0u32; points.len()];
+    for (k, &i) in order.iter().enumerate() {
+        rank[i as usize] = k as u32;
     }
-    out
+    rank.into_iter().map(|k| found[k as usize]).collect()
 }
 
 /// The smooth distance at every point (value only: the cheaper traversal).
@@ -105,37 +122,27 @@ pub fn values_and_gradients(object: &TraceObject, points: &[DVec3]) -> (Vec<f64>
     (s, g)
 }
 
-/// Queries per batch of [`nearest`]: each starts from its predecessor's answer.
-const NEAREST_BATCH: usize = 64;
-
 /// The exact nearest primitive to every point. The points are taken along a Morton curve
 /// in batches, each query starting from the previous one's nearest primitive
 /// (`eval::nearest`); the answers come back in the input order.
 pub fn nearest(object: &TraceObject, points: &[DVec3]) -> Vec<Nearest> {
     let sets = object.set_refs();
-    let sets = &sets;
-    let order = morton_order(points);
-    let found: Vec<Nearest> = order
-        .par_chunks(NEAREST_BATCH)
-        .flat_map_iter(|batch| {
-            let mut stack = Vec::new();
-            let mut hint: Option<Nearest> = None;
-            batch.iter().map(move |&i| {
+    in_morton_batches(points, BATCH, |batch| {
+        let mut stack = Vec::new();
+        let mut hint: Option<Nearest> = None;
+        batch
+            .iter()
+            .map(|&i| {
                 let x = points[i as usize];
                 let n = match &hint {
-                    Some(h) => eval::nearest::nearest_from(sets, x, h, &mut stack),
-                    None => eval::nearest(sets, x),
+                    Some(h) => eval::nearest::nearest_from(&sets, x, h, &mut stack),
+                    None => eval::nearest(&sets, x),
                 };
                 hint = Some(n);
                 n
             })
-        })
-        .collect();
-    let mut out = found.clone();
-    for (&i, n) in order.iter().zip(found) {
-        out[i as usize] = n;
-    }
-    out
+            .collect()
+    })
 }
 
 #[cfg(test)]
