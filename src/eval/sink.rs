@@ -190,6 +190,18 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
         }
     }
 
+    /// The slope along the ray of an exact term's `-ln(w exp(-alpha d)) / alpha`, from
+    /// that of its distance (`a`) and of its log-weight (`l`), in [-1, 1] (`eval::reach`:
+    /// to first order; the weight's own slope is `l / alpha`, zero for points).
+    #[inline]
+    fn term_slope(&self, a: f64, l: f64) -> f64 {
+        if l == 0.0 {
+            a
+        } else {
+            (a - l / self.acc.alpha()).clamp(-1.0, 1.0)
+        }
+    }
+
     /// A primitive's exact term.
     #[inline]
     pub fn exact<P: Primitive>(&mut self, prim: &P, x: DVec3, scale: &WeightScale) {
@@ -198,11 +210,13 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
             let t = prim.term(x, scale);
             let e = self.acc.add(t.d, t.w, t.dir, t.grad_w);
             if SLOPE {
-                self.add_slope(m, e, t.dir.dot(self.u));
+                let a = self.term_slope(t.dir.dot(self.u), t.grad_w.dot(self.u) / t.w);
+                self.add_slope(m, e, a);
             }
         } else if SLOPE {
-            let (d, w, a) = prim.value_slope(x, self.u, scale);
+            let (d, w, a, l) = prim.value_slope(x, self.u, scale);
             let e = self.acc.add_value(d, w);
+            let a = self.term_slope(a, l);
             self.add_slope(m, e, a);
         } else {
             let (d, w) = prim.value(x, scale);

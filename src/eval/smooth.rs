@@ -140,8 +140,8 @@ impl Along {
 
 /// Evaluates the smooth distance (with the gradient if `grad`) and how far along the
 /// unit direction `u` it provably stays positive (`Sample::reach`, at most `max_len`;
-/// `eval::reach`). Only sets of points have weights that do not vary along the ray: with
-/// any other set, or the naive sum, `reach` is `s`.
+/// `eval::reach`; on edges and triangles to first order in the weights' change). With
+/// the naive sum `reach` is `s`.
 pub fn evaluate_reach(
     sets: &[&AnySet],
     x: DVec3,
@@ -162,8 +162,7 @@ pub fn evaluate_along(
     p: &EvalParams,
     grad: bool,
 ) -> Sample {
-    let points = sets.iter().all(|s| matches!(s, AnySet::Points(_)));
-    let slope = points && p.accumulation == Accumulation::Stable;
+    let slope = p.accumulation == Accumulation::Stable;
     match (along.filter(|_| slope), grad) {
         (Some(a), true) => evaluate_impl::<true, true>(sets, x, a, p),
         (Some(a), false) => evaluate_impl::<false, true>(sets, x, a, p),

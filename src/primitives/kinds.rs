@@ -34,18 +34,20 @@ pub trait Primitive: Copy + Send + Sync + 'static {
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term;
     /// `(d, w)` only: what a value-only evaluation (sphere-tracing steps) needs.
     fn value(&self, x: DVec3, scale: &WeightScale) -> (f64, f64);
-    /// `(d, w, a)` with `a = u . (x - c) / d` the slope of the distance along unit `u`
-    /// (0 on the primitive): for the free distance of `eval::reach`.
+    /// `(d, w, a, l)` with `a = u . (x - c) / d` the slope of the distance along unit `u`
+    /// (0 on the primitive) and `l = u . grad w / w` that of `ln w`: for the free
+    /// distance of `eval::reach`.
     #[inline]
-    fn value_slope(&self, x: DVec3, u: DVec3, scale: &WeightScale) -> (f64, f64, f64) {
-        let (d, w) = self.value(x, scale);
-        let a = if d > 0.0 {
-            (x - self.closest_point(x)).dot(u) / d
-        } else {
-            0.0
-        };
-        (d, w, a)
+    fn value_slope(&self, x: DVec3, u: DVec3, scale: &WeightScale) -> (f64, f64, f64, f64) {
+        let t = self.term(x, scale);
+        (t.d, t.w, t.dir.dot(u), t.grad_w.dot(u) / t.w)
     }
+}
+
+/// The slope `u . v / d` of a distance `d = |v|` along unit `u` (0 where `d = 0`).
+#[inline]
+fn slope(v: DVec3, d: f64, u: DVec3) -> f64 {
+    if d > 0.0 { v.dot(u) / d } else { 0.0 }
 }
 
 #[inline]
@@ -78,10 +80,10 @@ impl Primitive for Point {
         ((x - self.p.as_dvec3()).length(), 1.0)
     }
     #[inline]
-    fn value_slope(&self, x: DVec3, u: DVec3, _scale: &WeightScale) -> (f64, f64, f64) {
+    fn value_slope(&self, x: DVec3, u: DVec3, _scale: &WeightScale) -> (f64, f64, f64, f64) {
         let v = x - self.p.as_dvec3();
         let d = v.length();
-        (d, 1.0, if d > 0.0 { v.dot(u) / d } else { 0.0 })
+        (d, 1.0, slope(v, d, u), 0.0)
     }
     #[inline]
     fn term(&self, x: DVec3, _scale: &WeightScale) -> Term {
@@ -128,6 +130,23 @@ impl Primitive for Edge {
             (x - c.point).length(),
             scale.weight(weights::edge_w(c.t, coef).0),
         )
+    }
+    #[inline]
+    fn value_slope(&self, x: DVec3, u: DVec3, scale: &WeightScale) -> (f64, f64, f64, f64) {
+        let (a, b) = (self.a.as_dvec3(), self.b.as_dvec3());
+        let c = closest_on_segment(x, a, b);
+        let v = x - c.point;
+        let d = v.length();
+        let coef = weights::edge_quartic(1.0 / self.val_a as f64, 1.0 / self.val_b as f64);
+        let (raw, draw) = weights::edge_w(c.t, coef);
+        let (w, dw) = scale.apply(raw);
+        let l = if c.interior && dw != 0.0 {
+            let ab = b - a;
+            dw * draw * ab.dot(u) / (ab.length_squared() * w)
+        } else {
+            0.0
+        };
+        (d, w, slope(v, d, u), l)
     }
     #[inline]
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term {
@@ -188,6 +207,19 @@ impl Primitive for Triangle {
         ((x - cl.point).length(), scale.weight(raw))
     }
     #[inline]
+    fn value_slope(&self, x: DVec3, u: DVec3, scale: &WeightScale) -> (f64, f64, f64, f64) {
+        let (a, b, c) = (self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3());
+        let cl = closest_on_triangle(x, a, b, c);
+        let v = x - cl.point;
+        let d = v.length();
+        let mut buf = [0.0; 13];
+        let k = weights::triangle_k(self.vmax, self.emax, &mut buf);
+        let (gs, gt) = weights::triangle_bary_gradients(cl.feature, b - a, c - a);
+        let (raw, draw) = weights::triangle_w_directional(cl.s, cl.t, gs.dot(u), gt.dot(u), k);
+        let (w, dw) = scale.apply(raw);
+        (d, w, slope(v, d, u), dw * draw / w)
+    }
+    #[inline]
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term {
         let (a, b, c) = (self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3());
         let cl = closest_on_triangle(x, a, b, c);
@@ -209,5 +241,67 @@ impl Primitive for Triangle {
             w,
             grad_w,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `value_slope` agrees with `term`: the distance's slope is `dir . u` and the
+    /// log-weight's `grad w . u / w`, which a central difference of `ln w` confirms.
+    #[test]
+    fn value_slope_matches_term_and_finite_differences() {
+        let scale = WeightScale::new(6.0, 100.0, 200.0);
+        let tri = Triangle {
+            a: Vec3::new(0.0, 0.0, 0.0),
+            b: Vec3::new(1.0, 0.1, 0.0),
+            c: Vec3::new(0.2, 0.9, 0.1),
+            vmax: 6.0,
+            emax: 2.0,
+        };
+        let edge = Edge {
+            a: Vec3::new(0.0, 0.0, 0.0),
+            b: Vec3::new(1.0, 0.3, -0.2),
+            val_a: 3.0,
+            val_b: 5.0,
+        };
+        let u = DVec3::new(0.3, -0.5, 0.8).normalize();
+        let (mut checked, mut varying) = (0, 0);
+        for i in 0..40 {
+            let f = i as f64 / 40.0;
+            let x = DVec3::new(0.9 * f - 0.1, 0.4 + 0.3 * (7.0 * f).sin(), 0.3 - 0.5 * f);
+            let tri_term = |y: DVec3| tri.term(y, &scale);
+            let edge_term = |y: DVec3| edge.term(y, &scale);
+            let cases: [(&dyn Fn(DVec3) -> Term, _); 2] = [
+                (&tri_term, tri.value_slope(x, u, &scale)),
+                (&edge_term, edge.value_slope(x, u, &scale)),
+            ];
+            for (term, (d, w, a, l)) in cases {
+                let t = term(x);
+                assert!((t.d - d).abs() < 1e-12 && (t.w - w).abs() < 1e-12);
+                assert!((t.dir.dot(u) - a).abs() < 1e-12);
+                assert!(
+                    (t.grad_w.dot(u) / t.w - l).abs() < 1e-9,
+                    "{} {l}",
+                    t.grad_w.dot(u) / t.w
+                );
+                varying += usize::from(l.abs() > 1e-3);
+                let h = 1e-6;
+                let fd = (term(x + h * u).w.ln() - term(x - h * u).w.ln()) / (2.0 * h);
+                if (fd - l).abs() < 1e-4 * (1.0 + l.abs()) {
+                    checked += 1;
+                }
+            }
+        }
+        // Central differences straddle a feature change (face to edge) at a few points.
+        assert!(
+            checked >= 76,
+            "{checked} of 80 agree with finite differences"
+        );
+        assert!(
+            varying >= 40,
+            "the weights vary at {varying} of 80 points only"
+        );
     }
 }

@@ -31,7 +31,7 @@ impl Tracer<'_> {
             t -= eps;
             let f = self.backtrack_sample(o + t * d, stats);
             if f.s >= -eps {
-                return Some(self.hit(o, d, t, &f, stats));
+                return Some(self.hit(o, d, (t, t), &f, stats));
             }
         }
         stats.exhausted = true;
@@ -61,7 +61,7 @@ impl Tracer<'_> {
             }
             let f = self.backtrack_sample(o + t * d, stats);
             if f.s.abs() <= eps || hi - lo <= eps {
-                return Some(self.hit(o, d, t, &f, stats));
+                return Some(self.hit(o, d, (t, lo), &f, stats));
             }
             last = Some((t, f));
             if f.s > 0.0 {
@@ -80,6 +80,6 @@ impl Tracer<'_> {
                 side = -1;
             }
         }
-        last.map(|(t, f)| self.hit(o, d, t, &f, stats))
+        last.map(|(t, f)| self.hit(o, d, (t, lo), &f, stats))
     }
 }

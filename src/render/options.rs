@@ -50,10 +50,11 @@ pub struct TracerOptions {
     pub clip: bool,
     pub backtrack: Backtrack,
     /// A hit at a positive value `s` is moved on by one more sphere-tracing step that
-    /// needs no evaluation (`s`, or on point clouds the free distance along the ray up
-    /// to `2 s`): that stretch is free of the surface, so the hit stays in front of it,
-    /// closer to it (tracer module docs, item 4). Off, the hit is the sample that came
-    /// within epsilon (the paper's).
+    /// needs no evaluation (`s`, or the free distance along the ray up to `2 s`): that
+    /// stretch is free of the surface, so the hit stays in front of it, closer to it; a
+    /// hit at a negative value is moved back to the crossing's first-order estimate
+    /// (tracer module docs, item 4). Off, the hit is the sample that came within
+    /// epsilon (the paper's).
     pub final_step: bool,
     /// Hits on edges and triangles are decided only where the value's certified gap
     /// (how far the exact value may lie above it) is at most `GAP_MAX` epsilons, halving

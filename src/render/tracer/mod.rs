@@ -16,12 +16,18 @@
 //!    (`render::backtrack`). A hit at a positive value `s` is moved on by one more
 //!    step that needs no evaluation: the value is a lower bound of the exact smooth
 //!    distance, which is 1-Lipschitz, so the ball of radius `s` around the sample holds
-//!    no point of the exact zero set; on point clouds the sample's free distance along
-//!    the ray (item 8, `eval::reach`) certifies as much, often more, and the step takes
-//!    it up to `2 s` ([`FINAL_REACH`]). The hit stays in front of the surface and comes
-//!    closer to it. The step is taken only where the gradient says the field falls along
-//!    the ray (a ray past its closest approach to a thin tube would only climb away). The
-//!    normal is the gradient at the sample (at most `2 epsilon` away).
+//!    no point of the exact zero set; the sample's free distance along the ray (item 8,
+//!    `eval::reach`) certifies as much, often more, and the step takes it up to `2 s`
+//!    ([`FINAL_REACH`]). The hit stays in front of the surface and comes closer to it.
+//!    On edges and triangles the free distance holds to first order in the weights'
+//!    change, and a step by it can land past the exact surface, in the band below zero:
+//!    a hit at a negative value there is moved back by the crossing's first-order
+//!    estimate `s / k` (`k` the field's fall along the ray, from the gradient), no
+//!    farther than the last positive sample. (On points every step is certain, and a
+//!    value below zero only says the Barnes-Hut sum is low there: the hit stays.) Both
+//!    moves are made only where the gradient says the field falls along the ray (a ray
+//!    past its closest approach to a thin tube would only climb away).
+//!    The normal is the gradient at the sample (at most `2 epsilon` away).
 //! 5. Far from the surface, steps are bound steps: a coarser Barnes-Hut sum
 //!    (`coarse_beta`, cheaper, and a lower bound of the scene's sum, so the steps stay
 //!    safe) until it falls below `coarse_threshold * epsilon` (`coarse_threshold_points`
@@ -55,9 +61,10 @@
 //!    halves the value (0.3-0.6 per step on logged lidar rays); a slope of 1 would
 //!    predict a hit, and pay for a fine evaluation, after every first full step.
 //! 8. Steps are over-relaxed (`render::stepper`): up to `2 s / (1 + k)` for a slope `k` of the
-//!    field along the ray, kept only when the next sample's ball closes the gap (on point
-//!    clouds, its free distance behind it, asked for only then: `eval::reach`), else
-//!    the ray returns to the plain step. Same surface, fewer steps at grazing incidence.
+//!    field along the ray, kept only when the next sample's ball closes the gap (or its
+//!    free distance behind it, asked for only then: `eval::reach`), else the ray
+//!    returns to the plain step; a sample's free distance ahead, when longer, is the
+//!    step. Same surface, fewer steps at grazing incidence.
 //! 9. Hits are decided at a finer beta (`TracerOptions::hit_beta_scale` times the
 //!    scene's, 0.6 by default): the Barnes-Hut sum is a lower bound of the exact one,
 //!    but where `alpha` times the size of far-field nodes is large (soft point clouds,
@@ -228,6 +235,9 @@ pub struct Tracer<'a> {
     sticky: bool,
     /// Bound steps are taken while the bound value exceeds this (item 5).
     tau: f64,
+    /// Per object: its terms have weights that vary along a ray (edges, triangles), so
+    /// its free distances hold to first order only (item 4).
+    weighted: Vec<bool>,
     /// Union of the grown object boxes.
     min: DVec3,
     max: DVec3,
@@ -295,6 +305,7 @@ impl<'a> Tracer<'a> {
             refine,
             sticky,
             tau,
+            weighted: points_only.iter().map(|&p| !p).collect(),
             min,
             max,
             options,
@@ -502,7 +513,8 @@ impl<'a> Tracer<'a> {
             }
             near = f.s - gap < 2.0 * tau;
             if f.s.abs() <= eps {
-                let hit = self.hit(o, d, t, &f, &mut stats);
+                let floor = prev.map_or(t, |p| p.0);
+                let hit = self.hit(o, d, (t, floor), &f, &mut stats);
                 return RayResult {
                     hit: Some(hit),
                     stats,
@@ -515,7 +527,7 @@ impl<'a> Tracer<'a> {
                     }
                     Some((tp, sp, _)) => self.backtrack(o, d, (tp, sp), (t, f.s), &mut stats),
                     // Negative at the first sample: the ray starts inside the band.
-                    None => Some(self.hit(o, d, t, &f, &mut stats)),
+                    None => Some(self.hit(o, d, (t, t), &f, &mut stats)),
                 };
                 return RayResult { hit, stats };
             }
@@ -554,11 +566,13 @@ impl<'a> Tracer<'a> {
         RayResult { hit: None, stats }
     }
 
+    /// The hit at the sample `f` at `t`; `floor` is a parameter known to lie in front of
+    /// the crossing (the last positive sample's, or `t`).
     pub(super) fn hit(
         &self,
         o: DVec3,
         d: DVec3,
-        t: f64,
+        (t, floor): (f64, f64),
         f: &FieldSample,
         stats: &mut RayStats,
     ) -> Hit {
@@ -566,11 +580,19 @@ impl<'a> Tracer<'a> {
             Some(g) => g,
             None => self.gradient(f.object, o + t * d, stats),
         };
-        // One more step, free, where the field falls along the ray: the sample's ball, or
-        // its free distance along the ray, is empty (module docs, item 4). (A free
-        // distance is never below `s`, and never NaN; `max` keeps it so.)
-        let t = if self.options.final_step && f.s > 0.0 && grad.dot(d) < 0.0 {
+        // Where the field falls along the ray (`k > 0`): one more step, free, from a
+        // positive value (the sample's ball, or its free distance along the ray, is
+        // empty), or from a negative one back to the crossing's first-order estimate
+        // (module docs, item 4). (A free distance is never below `s`, and never NaN;
+        // `max` keeps it so.)
+        let k = -grad.dot(d);
+        let falls = k > 0.0;
+        let t = if !self.options.final_step || !falls {
+            t
+        } else if f.s > 0.0 {
             t + f.reach.max(f.s).min(FINAL_REACH * f.s)
+        } else if self.weighted[f.object] {
+            (t + f.s / k).max(floor).min(t)
         } else {
             t
         };
