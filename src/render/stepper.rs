@@ -7,7 +7,10 @@
 #[derive(Clone, Copy, PartialEq)]
 pub(super) enum Kind {
     Bound,
+    /// A full value at the scene's (step) beta.
     Full,
+    /// A full value at the finer hit beta, where that differs (tracer item 9).
+    Fine,
 }
 
 /// Over-relaxed step lengths with their certificate (Keinert et al. 2014, "Enhanced

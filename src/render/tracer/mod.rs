@@ -476,6 +476,13 @@ impl<'a> Tracer<'a> {
                 },
             });
             let mut f = self.sample(x, &mut stats, want, fine, along, step_beta);
+            // Whether `f` is at the hit beta. On edges and triangles (`sticky`) a slope is
+            // only measured between values of one beta: the scene's is lower there by a
+            // share that changes along the ray, and a slope across the switch (0.2 where
+            // the field falls by 0.8) sent relaxed steps past the next sample's reach.
+            // Point clouds keep measuring across it (their steps took 3-75% more full
+            // evaluations per hit ray on 17 of the matrix's cells otherwise).
+            let mut f_fine = fine;
             if let Some(c) = coarse_at.take() {
                 gap = (f.s - c).max(0.0);
             }
@@ -493,6 +500,7 @@ impl<'a> Tracer<'a> {
                 stats.refinements += 1;
                 let coarse = f.s;
                 f = self.sample(x, &mut stats, Want::Gradient, true, along, step_beta);
+                f_fine = true;
                 if let Some(st) = steps.as_deref_mut() {
                     st.refined(coarse, f.s, eps);
                 }
@@ -534,7 +542,12 @@ impl<'a> Tracer<'a> {
             if let Some(n) = balls.as_deref_mut() {
                 n.note_along(x, f.s, d, f.reach);
             }
-            let step = stepper.step(prev, t, f.s, f.reach, Kind::Full);
+            let kind = if f_fine && refine && self.sticky {
+                Kind::Fine
+            } else {
+                Kind::Full
+            };
+            let step = stepper.step(prev, t, f.s, f.reach, kind);
             let step = through_chords(balls.as_deref_mut(), &mut stepper, t, f.reach, step);
             // The value at the next sample, if the field keeps its slope along the ray.
             // Before the slope is known (the first full value after bound steps), a step
