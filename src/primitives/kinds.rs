@@ -132,23 +132,6 @@ impl Primitive for Edge {
         )
     }
     #[inline]
-    fn value_slope(&self, x: DVec3, u: DVec3, scale: &WeightScale) -> (f64, f64, f64, f64) {
-        let (a, b) = (self.a.as_dvec3(), self.b.as_dvec3());
-        let c = closest_on_segment(x, a, b);
-        let v = x - c.point;
-        let d = v.length();
-        let coef = weights::edge_quartic(1.0 / self.val_a as f64, 1.0 / self.val_b as f64);
-        let (raw, draw) = weights::edge_w(c.t, coef);
-        let (w, dw) = scale.apply(raw);
-        let l = if c.interior && dw != 0.0 {
-            let ab = b - a;
-            dw * draw * ab.dot(u) / (ab.length_squared() * w)
-        } else {
-            0.0
-        };
-        (d, w, slope(v, d, u), l)
-    }
-    #[inline]
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term {
         let (a, b) = (self.a.as_dvec3(), self.b.as_dvec3());
         let c = closest_on_segment(x, a, b);
