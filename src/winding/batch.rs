@@ -56,7 +56,6 @@ pub struct Scratch {
     far: Vec<u32>,
     near: Vec<u32>,
     pairs: Vec<(u32, u32)>,
-    angles: lanes::AngleScratch,
 }
 
 /// The fast winding number at every point of `points` (see [`WindingTree`]), in
@@ -138,5 +137,5 @@ fn group(
         used,
         &mut s.pairs,
     );
-    lanes::solid_angles(&set.prims, &s.pairs, lanes, &mut s.angles);
+    lanes::solid_angles(&set.prims, &s.pairs, lanes);
 }

@@ -299,14 +299,8 @@ fn far_lanes<const AVX2: bool, const MASKED: bool>(
     MASKED && exact.iter().any(|&e| e)
 }
 
-/// Buffers of [`solid_angles`], reused between groups.
-#[derive(Default)]
-pub struct AngleScratch {
-    /// The triangles' corners relative to the queries: `a - q`, `b - q`, `c - q` per
-    /// axis, one entry per pair.
-    rel: [Vec<f64>; 9],
-    omega: Vec<f64>,
-}
+/// Solid angles computed together.
+const BLOCK: usize = 64;
 
 /// Adds the solid angles of the (lane, triangle) `pairs` to `lanes.angles`, in the
 /// order of the list.
@@ -314,14 +308,13 @@ pub fn solid_angles(
     prims: &[Triangle],
     pairs: &[(u32, u32)],
     lanes: &mut Lanes,
-    s: &mut AngleScratch,
 ) {
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
         // SAFETY: the processor supports the features the function is compiled for.
-        return unsafe { solid_angles_avx2(prims, pairs, lanes, s) };
+        return unsafe { solid_angles_avx2(prims, pairs, lanes) };
     }
-    solid_angles_in(prims, pairs, lanes, s)
+    solid_angles_in(prims, pairs, lanes)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -330,61 +323,44 @@ fn solid_angles_avx2(
     prims: &[Triangle],
     pairs: &[(u32, u32)],
     lanes: &mut Lanes,
-    s: &mut AngleScratch,
 ) {
-    solid_angles_in(prims, pairs, lanes, s)
+    solid_angles_in(prims, pairs, lanes)
 }
 
 /// The corners of every pair's triangle relative to its query (a gather), then
-/// [`super::exact::solid_angle`] over the whole list, one loop per step so that each
-/// vectorizes.
+/// [`super::exact::solid_angle`], [`BLOCK`] pairs at a time, one loop per step so that
+/// each vectorizes.
 #[inline(always)]
-fn solid_angles_in(
-    prims: &[Triangle],
-    pairs: &[(u32, u32)],
-    lanes: &mut Lanes,
-    s: &mut AngleScratch,
-) {
-    let n = pairs.len();
-    for r in &mut s.rel {
-        r.clear();
-    }
-    for &(k, t) in pairs {
-        let q = lanes.get(k as usize);
-        let t = &prims[t as usize];
-        for (j, corner) in [t.a, t.b, t.c].into_iter().enumerate() {
-            let r = corner.as_dvec3() - q;
-            s.rel[3 * j].push(r.x);
-            s.rel[3 * j + 1].push(r.y);
-            s.rel[3 * j + 2].push(r.z);
+fn solid_angles_in(prims: &[Triangle], pairs: &[(u32, u32)], lanes: &mut Lanes) {
+    for block in pairs.chunks(BLOCK) {
+        let n = block.len();
+        let mut rel = [[0.0f64; BLOCK]; 9];
+        for (j, &(k, t)) in block.iter().enumerate() {
+            let q = lanes.get(k as usize);
+            let t = &prims[t as usize];
+            for (c, corner) in [t.a, t.b, t.c].into_iter().enumerate() {
+                let r = corner.as_dvec3() - q;
+                (rel[3 * c][j], rel[3 * c + 1][j], rel[3 * c + 2][j]) = (r.x, r.y, r.z);
+            }
         }
-    }
-    s.omega.clear();
-    s.omega.resize(n, 0.0);
-    let [ax, ay, az, bx, by, bz, cx, cy, cz] = &s.rel;
-    let (ax, ay, az) = (&ax[..n], &ay[..n], &az[..n]);
-    let (bx, by, bz) = (&bx[..n], &by[..n], &bz[..n]);
-    let (cx, cy, cz) = (&cx[..n], &cy[..n], &cz[..n]);
-    let omega = &mut s.omega[..n];
-    for j in 0..n {
-        let (a, b, c) = (
-            [ax[j], ay[j], az[j]],
-            [bx[j], by[j], bz[j]],
-            [cx[j], cy[j], cz[j]],
-        );
-        let dot = |u: [f64; 3], w: [f64; 3]| u[0] * w[0] + u[1] * w[1] + u[2] * w[2];
-        let (la, lb, lc) = (dot(a, a).sqrt(), dot(b, b).sqrt(), dot(c, c).sqrt());
-        let bc = [
-            b[1] * c[2] - b[2] * c[1],
-            b[2] * c[0] - b[0] * c[2],
-            b[0] * c[1] - b[1] * c[0],
-        ];
-        let num = dot(a, bc);
-        let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
-        omega[j] = 2.0 * atan2(num, den);
-    }
-    for (&(k, _), w) in pairs.iter().zip(omega.iter()) {
-        lanes.angles[k as usize] += w;
+        let mut omega = [0.0f64; BLOCK];
+        let [ax, ay, az, bx, by, bz, cx, cy, cz] = &rel;
+        for j in 0..n {
+            let (a, b, c) = ([ax[j], ay[j], az[j]], [bx[j], by[j], bz[j]], [cx[j], cy[j], cz[j]]);
+            let dot = |u: [f64; 3], w: [f64; 3]| u[0] * w[0] + u[1] * w[1] + u[2] * w[2];
+            let (la, lb, lc) = (dot(a, a).sqrt(), dot(b, b).sqrt(), dot(c, c).sqrt());
+            let bc = [
+                b[1] * c[2] - b[2] * c[1],
+                b[2] * c[0] - b[0] * c[2],
+                b[0] * c[1] - b[1] * c[0],
+            ];
+            let num = dot(a, bc);
+            let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+            omega[j] = 2.0 * atan2(num, den);
+        }
+        for (&(k, _), w) in block.iter().zip(&omega) {
+            lanes.angles[k as usize] += w;
+        }
     }
 }
 
@@ -437,7 +413,7 @@ mod tests {
     fn pair_angle(prims: &[Triangle], pair: (u32, u32), lanes: &Lanes) -> f64 {
         let mut l = *lanes;
         l.angles = [0.0; GROUP];
-        solid_angles(prims, &[pair], &mut l, &mut AngleScratch::default());
+        solid_angles(prims, &[pair], &mut l);
         l.angles[pair.0 as usize]
     }
 
@@ -527,12 +503,7 @@ mod tests {
             want[pair.0 as usize] += b;
         }
         assert_eq!(pair_angle(&prims, (5, 2), &lanes), 0.0);
-        solid_angles(
-            &prims,
-            &pairs[..pairs.len() - 3],
-            &mut lanes,
-            &mut AngleScratch::default(),
-        );
+        solid_angles(&prims, &pairs[..pairs.len() - 3], &mut lanes);
         for &pair in &pairs[pairs.len() - 3..] {
             want[pair.0 as usize] -= pair_angle_reference(&prims, pair, &lanes);
         }
