@@ -304,11 +304,7 @@ const BLOCK: usize = 64;
 
 /// Adds the solid angles of the (lane, triangle) `pairs` to `lanes.angles`, in the
 /// order of the list.
-pub fn solid_angles(
-    prims: &[Triangle],
-    pairs: &[(u32, u32)],
-    lanes: &mut Lanes,
-) {
+pub fn solid_angles(prims: &[Triangle], pairs: &[(u32, u32)], lanes: &mut Lanes) {
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
         // SAFETY: the processor supports the features the function is compiled for.
@@ -319,11 +315,7 @@ pub fn solid_angles(
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn solid_angles_avx2(
-    prims: &[Triangle],
-    pairs: &[(u32, u32)],
-    lanes: &mut Lanes,
-) {
+fn solid_angles_avx2(prims: &[Triangle], pairs: &[(u32, u32)], lanes: &mut Lanes) {
     solid_angles_in(prims, pairs, lanes)
 }
 
@@ -346,7 +338,11 @@ fn solid_angles_in(prims: &[Triangle], pairs: &[(u32, u32)], lanes: &mut Lanes) 
         let mut omega = [0.0f64; BLOCK];
         let [ax, ay, az, bx, by, bz, cx, cy, cz] = &rel;
         for j in 0..n {
-            let (a, b, c) = ([ax[j], ay[j], az[j]], [bx[j], by[j], bz[j]], [cx[j], cy[j], cz[j]]);
+            let (a, b, c) = (
+                [ax[j], ay[j], az[j]],
+                [bx[j], by[j], bz[j]],
+                [cx[j], cy[j], cz[j]],
+            );
             let dot = |u: [f64; 3], w: [f64; 3]| u[0] * w[0] + u[1] * w[1] + u[2] * w[2];
             let (la, lb, lc) = (dot(a, a).sqrt(), dot(b, b).sqrt(), dot(c, c).sqrt());
             let bc = [
