@@ -130,7 +130,7 @@ mod tests {
                 let keys: Vec<u64> = (0..n)
                     .map(|_| match kind {
                         0 => rnd(),
-                        1 => rnd() % 7 << 40,
+                        1 => (rnd() % 7) << 40,
                         _ => rnd() % 1000,
                     })
                     .collect();
