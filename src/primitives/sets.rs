@@ -249,36 +249,36 @@ fn triangles(mesh: &Mesh) -> Option<(Vec<Triangle>, f64)> {
             }
         }
     }
+    // Each edge's count of incident triangles, from the runs of equal keys in the sorted
+    // (edge, triangle) list; `emax` per triangle is the largest of its edges'.
     let key = |a: u32, b: u32| ((a.min(b) as u64) << 32) | a.max(b) as u64;
-    let mut keys: Vec<u64> = mesh
+    let mut keys: Vec<(u64, u32)> = mesh
         .triangles
-        .iter()
-        .flat_map(|t| [key(t[0], t[1]), key(t[1], t[2]), key(t[2], t[0])])
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(i, t)| {
+            [key(t[0], t[1]), key(t[1], t[2]), key(t[2], t[0])].map(|k| (k, i as u32))
+        })
         .collect();
-    keys.par_sort_unstable();
-    let count_of = |k: u64| -> u32 {
-        let lo = keys.partition_point(|&x| x < k);
-        let hi = keys.partition_point(|&x| x <= k);
-        (hi - lo) as u32
-    };
-    let mut max_e = 1u32;
+    keys.par_sort_unstable_by_key(|&(k, _)| k);
+    let mut emax = vec![1u32; mesh.triangles.len()];
+    for run in keys.chunk_by(|x, y| x.0 == y.0) {
+        for &(_, i) in run {
+            emax[i as usize] = emax[i as usize].max(run.len() as u32);
+        }
+    }
+    let max_e = emax.par_iter().copied().max().unwrap_or(1);
     let prims: Vec<Triangle> = mesh
         .triangles
-        .iter()
-        .map(|t| {
+        .par_iter()
+        .zip(emax.par_iter())
+        .map(|(t, &emax)| {
             let vmax = t
                 .iter()
                 .map(|&i| vval[i as usize])
                 .max()
                 .unwrap_or(1)
                 .max(1);
-            let emax = [key(t[0], t[1]), key(t[1], t[2]), key(t[2], t[0])]
-                .into_iter()
-                .map(count_of)
-                .max()
-                .unwrap_or(1)
-                .max(1);
-            max_e = max_e.max(emax);
             Triangle {
                 a: mesh.vertices[t[0] as usize],
                 b: mesh.vertices[t[1] as usize],

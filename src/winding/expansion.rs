@@ -237,6 +237,13 @@ pub struct FarPoly {
     pub g: [f32; 3],
 }
 
+/// Index of the cubic monomial `u_a u_b u_c` (`a <= b <= c`) in [`FarPoly::cubic`].
+const MONO: [[[usize; 3]; 3]; 3] = [
+    [[0, 1, 2], [0, 3, 4], [0, 0, 5]],
+    [[0, 0, 0], [0, 6, 7], [0, 0, 8]],
+    [[0, 0, 0], [0, 0, 0], [0, 0, 9]],
+];
+
 /// Index of the symmetric pair `(j, k)` in [`FarField::t`]'s rows.
 const PAIR: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
 
@@ -253,20 +260,9 @@ impl FarPoly {
         // Cubic monomials u_a u_b u_c, a <= b <= c, in the order 000 001 002 011 012 022
         // 111 112 122 222.
         let mono = |x: usize, y: usize, z: usize| {
-            let mut v = [x, y, z];
-            v.sort_unstable();
-            match v {
-                [0, 0, 0] => 0,
-                [0, 0, 1] => 1,
-                [0, 0, 2] => 2,
-                [0, 1, 1] => 3,
-                [0, 1, 2] => 4,
-                [0, 2, 2] => 5,
-                [1, 1, 1] => 6,
-                [1, 1, 2] => 7,
-                [1, 2, 2] => 8,
-                _ => 9,
-            }
+            let (lo, hi) = (x.min(y).min(z), x.max(y).max(z));
+            let mid = x + y + z - lo - hi;
+            MONO[lo][mid][hi]
         };
         let mut cubic = [0.0f32; 10];
         let mut g = [0.0f32; 3];

@@ -11,6 +11,8 @@
 //! - [`exact`]: the solid angle of a triangle (Van Oosterom and Strackee 1983) and the
 //!   brute-force references.
 //! - [`expansion`]: a cluster's moments and its second-order far field.
+//! - [`batch`] and [`lanes`]: many queries at once, in groups of neighbours that share
+//!   one walk, with the arithmetic written over the group's lanes for the vectorizer.
 //! - [`tree`]: the far fields of a triangle set's BVH nodes and the query walk, with the
 //!   accuracy parameter `beta` (far field when a node's radius is below `beta` times the
 //!   distance to its centre; 0 = exact).
@@ -23,6 +25,7 @@ pub mod batch;
 pub mod boundary;
 pub mod exact;
 pub mod expansion;
+pub mod lanes;
 pub mod signed;
 pub mod tree;
 

@@ -30,30 +30,15 @@ pub struct WindingTree {
 }
 
 impl WindingTree {
-    /// Builds the far fields of `set`'s BVH nodes, children before parents (the
-    /// depth-first layout puts every child after its parent).
+    /// Builds the far fields of `set`'s BVH nodes, children before parents: subtrees
+    /// side by side in parallel (the depth-first layout puts a node's subtree in one
+    /// range, its left child right after it), each small subtree by one loop from its
+    /// last node back to its root.
     pub fn build(set: &PrimitiveSet<Triangle>) -> WindingTree {
         let nodes = &set.bvh.nodes;
-        let mut moments: Vec<Moments> = vec![Moments::default(); nodes.len()];
         let mut far = vec![FarField::default(); nodes.len()];
-        for i in (0..nodes.len()).rev() {
-            let node = &nodes[i];
-            let (m, r2) = if node.is_leaf() {
-                leaf(set, node)
-            } else {
-                let (l, r) = (&moments[i + 1], &moments[node.index as usize]);
-                let centre = centre_of(l.area_centroid + r.area_centroid, l.area + r.area, node);
-                let mut m = l.shifted(centre);
-                m.add(&r.shifted(centre));
-                // Every triangle lies within a child's radius of its centre, and in the
-                // node's box.
-                let reach =
-                    |k: usize| (far[k].centre() - centre).length() + (far[k].r2 as f64).sqrt();
-                let r = reach(i + 1).max(reach(node.index as usize));
-                (m, r.min(box_reach(node, centre)).powi(2))
-            };
-            far[i] = m.far_field(grow(r2));
-            moments[i] = m;
+        if !nodes.is_empty() {
+            subtree(set, 0, &mut far);
         }
         // The exact radius of each node about its centre (tighter than the children's
         // reach): every node's triangles are a contiguous range in leaf order.
@@ -76,7 +61,7 @@ impl WindingTree {
                 .fold(0.0f64, f64::max);
             f.r2 = grow(r2) as f32;
         });
-        let poly = far.iter().map(FarPoly::new).collect();
+        let poly = far.par_iter().map(FarPoly::new).collect();
         WindingTree { far, poly }
     }
 
@@ -140,6 +125,61 @@ impl WindingTree {
         }
         (far_sum + angles / (4.0 * PI), fars, exacts)
     }
+}
+
+/// Subtrees with more nodes than this build their two halves in parallel.
+const PARALLEL_MIN: usize = 2048;
+
+/// Fills `far` (the far fields of the subtree of node `i`, which starts at `i` and spans
+/// `far.len()` nodes) and returns the moments of node `i`.
+fn subtree(set: &PrimitiveSet<Triangle>, i: usize, far: &mut [FarField]) -> Moments {
+    let node = &set.bvh.nodes[i];
+    if node.is_leaf() || far.len() <= PARALLEL_MIN {
+        return serial(set, i, far);
+    }
+    let right = node.index as usize;
+    let (head, rest) = far.split_at_mut(1);
+    let (lf, rf) = rest.split_at_mut(right - i - 1);
+    let (l, r) = rayon::join(|| subtree(set, i + 1, lf), || subtree(set, right, rf));
+    let (m, r2) = inner(node, &l, &r, &lf[0], &rf[0]);
+    head[0] = m.far_field(grow(r2));
+    m
+}
+
+/// [`subtree`] in one loop over the nodes, last to first.
+fn serial(set: &PrimitiveSet<Triangle>, root: usize, far: &mut [FarField]) -> Moments {
+    let nodes = &set.bvh.nodes[root..root + far.len()];
+    let mut moments: Vec<Moments> = vec![Moments::default(); far.len()];
+    for k in (0..nodes.len()).rev() {
+        let node = &nodes[k];
+        let (m, r2) = if node.is_leaf() {
+            leaf(set, node)
+        } else {
+            let right = node.index as usize - root;
+            inner(
+                node,
+                &moments[k + 1],
+                &moments[right],
+                &far[k + 1],
+                &far[right],
+            )
+        };
+        far[k] = m.far_field(grow(r2));
+        moments[k] = m;
+    }
+    moments[0]
+}
+
+/// The moments of an inner node from its children's (moments and far fields) and a
+/// bound on its squared radius: every triangle lies within a child's radius of its
+/// centre, and in the node's box.
+fn inner(node: &Node, l: &Moments, r: &Moments, fl: &FarField, fr: &FarField) -> (Moments, f64) {
+    let centre = centre_of(l.area_centroid + r.area_centroid, l.area + r.area, node);
+    let mut m = l.shifted(centre);
+    m.add(&r.shifted(centre));
+    let reach = |f: &FarField| (f.centre() - centre).length() + (f.r2 as f64).sqrt();
+    let radius = reach(fl).max(reach(fr));
+    (m, radius.min(box_reach(node, centre)).powi(2))
 }
 
 /// The moments and squared radius of a leaf's triangles about their area-weighted
