@@ -5,7 +5,7 @@
 //! closest points and weights are computed in f64.
 
 use super::weights::{self, WeightScale};
-use crate::geometry::closest::{closest_on_segment, closest_on_triangle};
+use crate::geometry::closest::{TriangleClosest, closest_on_segment, closest_on_triangle};
 use crate::mesh::Aabb;
 use glam::{DVec3, Vec3};
 
@@ -167,6 +167,28 @@ pub struct Triangle {
     pub emax: f32,
 }
 
+impl Triangle {
+    /// The closest point to `x`, the offset `x - c` from it and its length `d`.
+    #[inline]
+    fn offset(&self, x: DVec3) -> (TriangleClosest, DVec3, f64) {
+        let (a, b, c) = (self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3());
+        let cl = closest_on_triangle(x, a, b, c);
+        let v = x - cl.point;
+        (cl, v, v.length())
+    }
+
+    /// The edges `b - a` and `c - a` (the barycentric gradients' basis).
+    #[inline]
+    fn e1(&self) -> DVec3 {
+        self.b.as_dvec3() - self.a.as_dvec3()
+    }
+
+    #[inline]
+    fn e2(&self) -> DVec3 {
+        self.c.as_dvec3() - self.a.as_dvec3()
+    }
+}
+
 impl Primitive for Triangle {
     fn bounds(&self) -> Aabb {
         Aabb {
@@ -191,29 +213,23 @@ impl Primitive for Triangle {
     }
     #[inline]
     fn value_slope(&self, x: DVec3, u: DVec3, scale: &WeightScale) -> (f64, f64, f64, f64) {
-        let (a, b, c) = (self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3());
-        let cl = closest_on_triangle(x, a, b, c);
-        let v = x - cl.point;
-        let d = v.length();
+        let (cl, v, d) = self.offset(x);
         let mut buf = [0.0; 13];
         let k = weights::triangle_k(self.vmax, self.emax, &mut buf);
-        let (gs, gt) = weights::triangle_bary_gradients(cl.feature, b - a, c - a);
+        let (gs, gt) = weights::triangle_bary_gradients(cl.feature, self.e1(), self.e2());
         let (raw, draw) = weights::triangle_w_directional(cl.s, cl.t, gs.dot(u), gt.dot(u), k);
         let (w, dw) = scale.apply(raw);
         (d, w, slope(v, d, u), dw * draw / w)
     }
     #[inline]
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term {
-        let (a, b, c) = (self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3());
-        let cl = closest_on_triangle(x, a, b, c);
-        let v = x - cl.point;
-        let d = v.length();
+        let (cl, v, d) = self.offset(x);
         let mut buf = [0.0; 13];
         let k = weights::triangle_k(self.vmax, self.emax, &mut buf);
         let (raw, ws, wt) = weights::triangle_w_grad(cl.s, cl.t, k);
         let (w, dw) = scale.apply(raw);
         let grad_w = if dw != 0.0 {
-            let (gs, gt) = weights::triangle_bary_gradients(cl.feature, b - a, c - a);
+            let (gs, gt) = weights::triangle_bary_gradients(cl.feature, self.e1(), self.e2());
             dw * (ws * gs + wt * gt)
         } else {
             DVec3::ZERO
