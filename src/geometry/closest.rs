@@ -103,28 +103,87 @@ pub struct TriangleClosest {
 /// `Degenerate`.
 #[inline]
 pub fn closest_on_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> TriangleClosest {
-    let l_bc = (c - b).length_squared();
-    let l_ac = (c - a).length_squared();
-    let l_ab = (b - a).length_squared();
-    let solved = if l_bc >= l_ac && l_bc >= l_ab {
+    closest_on_triangle_ordered(x, a, b, c, triangle_order(a, b, c))
+}
+
+/// What [`closest_on_triangle`] decides about a triangle before it looks at the query:
+/// the vertex with the largest angle (0, 1, 2 for `a`, `b`, `c`), or [`DEGENERATE`].
+/// Computed once per triangle (`primitives::Triangle`), it spares every query three
+/// edge lengths and the degeneracy test; the results are the same to the last bit.
+#[inline]
+pub fn triangle_order(a: DVec3, b: DVec3, c: DVec3) -> u8 {
+    let order = largest_angle(a, b, c);
+    let (o, p, q) = rotated(a, b, c, order);
+    if is_degenerate(p - o, q - o) {
+        DEGENERATE
+    } else {
+        order
+    }
+}
+
+/// [`triangle_order`] of a triangle whose closest points take the edges' fallback.
+pub const DEGENERATE: u8 = 3;
+
+/// [`closest_on_triangle`] for a triangle whose [`triangle_order`] is `order`.
+#[inline]
+pub fn closest_on_triangle_ordered(
+    x: DVec3,
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+    order: u8,
+) -> TriangleClosest {
+    let solved = match order {
         // The largest angle is at `a`: no rotation.
-        closest_from_largest_angle(x, a, b, c)
-    } else if l_ac >= l_ab {
+        0 => closest_from_largest_angle(x, a, b, c),
         // Largest angle at `b`: solve for (b, c, a), then map back.
-        closest_from_largest_angle(x, b, c, a).map(|r| {
+        1 => closest_from_largest_angle(x, b, c, a).map(|r| {
             let [ub, uc, _] = weights_of(&r);
             let feature = rotate_feature(r.feature, [F::VertexB, F::VertexC, F::VertexA]);
             tri(r.point, ub, uc, feature)
-        })
-    } else {
+        }),
         // Largest angle at `c`: solve for (c, a, b), then map back.
-        closest_from_largest_angle(x, c, a, b).map(|r| {
+        2 => closest_from_largest_angle(x, c, a, b).map(|r| {
             let [uc, _, ub] = weights_of(&r);
             let feature = rotate_feature(r.feature, [F::VertexC, F::VertexA, F::VertexB]);
             tri(r.point, ub, uc, feature)
-        })
+        }),
+        _ => None,
     };
     solved.unwrap_or_else(|| closest_on_degenerate_triangle(x, a, b, c))
+}
+
+/// The vertex with the largest angle: the one opposite the longest edge (0, 1, 2).
+#[inline]
+fn largest_angle(a: DVec3, b: DVec3, c: DVec3) -> u8 {
+    let l_bc = (c - b).length_squared();
+    let l_ac = (c - a).length_squared();
+    let l_ab = (b - a).length_squared();
+    if l_bc >= l_ac && l_bc >= l_ab {
+        0
+    } else if l_ac >= l_ab {
+        1
+    } else {
+        2
+    }
+}
+
+/// The vertices from the one with the largest angle on, in the triangle's order.
+#[inline]
+fn rotated(a: DVec3, b: DVec3, c: DVec3, order: u8) -> (DVec3, DVec3, DVec3) {
+    match order {
+        0 => (a, b, c),
+        1 => (b, c, a),
+        _ => (c, a, b),
+    }
+}
+
+/// The degeneracy test of the edges `e1`, `e2` that meet at the largest angle (see
+/// `DEGENERATE_SIN2`; zero-length edges give 0 <= 0, NaN input is degenerate too).
+#[inline]
+fn is_degenerate(e1: DVec3, e2: DVec3) -> bool {
+    let n2 = e1.cross(e2).length_squared();
+    n2.is_nan() || n2 <= DEGENERATE_SIN2 * e1.length_squared() * e2.length_squared()
 }
 
 /// True when `closest_on_triangle` treats `(a, b, c)` as degenerate (the squared sine of
@@ -137,25 +196,9 @@ pub fn triangle_is_degenerate(a: DVec3, b: DVec3, c: DVec3) -> bool {
 /// from its largest angle (same direction, better rounding); `None` when
 /// `closest_on_triangle` treats the triangle as degenerate.
 pub fn triangle_normal(a: DVec3, b: DVec3, c: DVec3) -> Option<DVec3> {
-    let l_bc = (c - b).length_squared();
-    let l_ac = (c - a).length_squared();
-    let l_ab = (b - a).length_squared();
-    let (o, p, q) = if l_bc >= l_ac && l_bc >= l_ab {
-        (a, b, c)
-    } else if l_ac >= l_ab {
-        (b, c, a)
-    } else {
-        (c, a, b)
-    };
+    let (o, p, q) = rotated(a, b, c, largest_angle(a, b, c));
     let (e1, e2) = (p - o, q - o);
-    let n = e1.cross(e2);
-    let n2 = n.length_squared();
-    // Zero-length edges give 0 <= 0; NaN input fails the comparison.
-    if n2 > DEGENERATE_SIN2 * e1.length_squared() * e2.length_squared() {
-        Some(n)
-    } else {
-        None
-    }
+    (!is_degenerate(e1, e2)).then(|| e1.cross(e2))
 }
 
 use TriFeature as F;
@@ -192,18 +235,13 @@ fn rotate_feature(f: TriFeature, v: [TriFeature; 3]) -> TriFeature {
     }
 }
 
-/// Ericson's Voronoi-region solve with `a` at the triangle's largest angle; `None` when
-/// the triangle is degenerate (or the face solve is not finite, which only rounding at
-/// the threshold can cause).
+/// Ericson's Voronoi-region solve with `a` at the triangle's largest angle, for a
+/// triangle that [`triangle_order`] found not degenerate; `None` when the face solve is
+/// not finite (which only rounding at the degeneracy threshold can cause).
 #[inline]
 fn closest_from_largest_angle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<TriangleClosest> {
     let ab = b - a;
     let ac = c - a;
-    let n2 = ab.cross(ac).length_squared();
-    // Zero-length edges give 0 <= 0; NaN input is degenerate too.
-    if n2.is_nan() || n2 <= DEGENERATE_SIN2 * ab.length_squared() * ac.length_squared() {
-        return None;
-    }
     let ap = x - a;
     let d1 = ab.dot(ap);
     let d2 = ac.dot(ap);

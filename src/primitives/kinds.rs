@@ -5,7 +5,9 @@
 //! closest points and weights are computed in f64.
 
 use super::weights::{self, WeightScale};
-use crate::geometry::closest::{TriangleClosest, closest_on_segment, closest_on_triangle};
+use crate::geometry::closest::{
+    TriangleClosest, closest_on_segment, closest_on_triangle_ordered, triangle_order,
+};
 use crate::mesh::Aabb;
 use glam::{DVec3, Vec3};
 
@@ -165,14 +167,37 @@ pub struct Triangle {
     pub vmax: f32,
     /// Largest number of triangles incident on one of its edges (>= 1).
     pub emax: f32,
+    /// Its vertex with the largest angle, or that it is degenerate
+    /// (`geometry::closest::triangle_order`), decided once for every query.
+    pub order: u8,
+    /// Where its weight's coefficients are tabulated (`weights::triangle_table_row`).
+    pub row: u16,
 }
 
 impl Triangle {
+    pub fn new(a: Vec3, b: Vec3, c: Vec3, vmax: f32, emax: f32) -> Triangle {
+        Triangle {
+            a,
+            b,
+            c,
+            vmax,
+            emax,
+            order: triangle_order(a.as_dvec3(), b.as_dvec3(), c.as_dvec3()),
+            row: weights::triangle_table_row(vmax, emax),
+        }
+    }
+
+    /// The closest point to `x`.
+    #[inline]
+    fn closest(&self, x: DVec3) -> TriangleClosest {
+        let (a, b, c) = (self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3());
+        closest_on_triangle_ordered(x, a, b, c, self.order)
+    }
+
     /// The closest point to `x`, the offset `x - c` from it and its length `d`.
     #[inline]
     fn offset(&self, x: DVec3) -> (TriangleClosest, DVec3, f64) {
-        let (a, b, c) = (self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3());
-        let cl = closest_on_triangle(x, a, b, c);
+        let cl = self.closest(x);
         let v = x - cl.point;
         (cl, v, v.length())
     }
@@ -200,14 +225,13 @@ impl Primitive for Triangle {
         (self.a + self.b + self.c) / 3.0
     }
     fn closest_point(&self, x: DVec3) -> DVec3 {
-        closest_on_triangle(x, self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3()).point
+        self.closest(x).point
     }
     #[inline]
     fn value(&self, x: DVec3, scale: &WeightScale) -> (f64, f64) {
-        let (a, b, c) = (self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3());
-        let cl = closest_on_triangle(x, a, b, c);
+        let cl = self.closest(x);
         let mut buf = [0.0; 13];
-        let k = weights::triangle_k(self.vmax, self.emax, &mut buf);
+        let k = weights::triangle_k(self.row, self.vmax, self.emax, &mut buf);
         let raw = weights::triangle_w_value(cl.s, cl.t, k);
         ((x - cl.point).length(), scale.weight(raw))
     }
@@ -215,7 +239,7 @@ impl Primitive for Triangle {
     fn value_slope(&self, x: DVec3, u: DVec3, scale: &WeightScale) -> (f64, f64, f64, f64) {
         let (cl, v, d) = self.offset(x);
         let mut buf = [0.0; 13];
-        let k = weights::triangle_k(self.vmax, self.emax, &mut buf);
+        let k = weights::triangle_k(self.row, self.vmax, self.emax, &mut buf);
         let (gs, gt) = weights::triangle_bary_gradients(cl.feature, self.e1(), self.e2());
         let (raw, draw) = weights::triangle_w_directional(cl.s, cl.t, gs.dot(u), gt.dot(u), k);
         let (w, dw) = scale.apply(raw);
@@ -225,7 +249,7 @@ impl Primitive for Triangle {
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term {
         let (cl, v, d) = self.offset(x);
         let mut buf = [0.0; 13];
-        let k = weights::triangle_k(self.vmax, self.emax, &mut buf);
+        let k = weights::triangle_k(self.row, self.vmax, self.emax, &mut buf);
         let (raw, ws, wt) = weights::triangle_w_grad(cl.s, cl.t, k);
         let (w, dw) = scale.apply(raw);
         let grad_w = if dw != 0.0 {
@@ -247,18 +271,58 @@ impl Primitive for Triangle {
 mod tests {
     use super::*;
 
+    /// What `Triangle::new` decides once (the vertex with the largest angle or
+    /// degeneracy, the weight's table row) gives what deciding it per query gives, to the
+    /// last bit: skinny, degenerate and untabulated triangles included.
+    #[test]
+    fn stored_decisions_give_the_per_query_results() {
+        use crate::geometry::closest::closest_on_triangle;
+        let mut seed = 7u64;
+        let mut r = move || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f32 / (1u64 << 53) as f32 - 0.5
+        };
+        let scale = WeightScale::new(40.0, 100.0, 200.0);
+        for i in 0..300 {
+            let mut v = || Vec3::new(r(), r(), r());
+            let (a, mut b, mut c) = (v(), v(), v());
+            match i % 5 {
+                0 => c = a + 2.0 * (b - a), // collinear
+                1 => b = a,                 // coincident
+                2 => c = b + (b - a) * 1e3, // long and thin
+                _ => {}
+            }
+            let (vmax, emax) = if i % 3 == 0 { (40.0, 12.0) } else { (6.0, 2.0) };
+            let tri = Triangle::new(a, b, c, vmax, emax);
+            let k = weights::triangle_coefficients(vmax as f64, emax as f64);
+            for _ in 0..10 {
+                let x = DVec3::new(r() as f64, r() as f64, r() as f64) * 3.0;
+                let cl = closest_on_triangle(x, a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+                assert_eq!(tri.closest_point(x), cl.point, "triangle {i}");
+                let want = scale.weight(weights::triangle_w_value(cl.s, cl.t, &k));
+                assert_eq!(
+                    tri.value(x, &scale),
+                    ((x - cl.point).length(), want),
+                    "triangle {i}"
+                );
+            }
+        }
+    }
+
     /// `value_slope` agrees with `term`: the distance's slope is `dir . u` and the
     /// log-weight's `grad w . u / w`, which a central difference of `ln w` confirms.
     #[test]
     fn value_slope_matches_term_and_finite_differences() {
         let scale = WeightScale::new(6.0, 100.0, 200.0);
-        let tri = Triangle {
-            a: Vec3::new(0.0, 0.0, 0.0),
-            b: Vec3::new(1.0, 0.1, 0.0),
-            c: Vec3::new(0.2, 0.9, 0.1),
-            vmax: 6.0,
-            emax: 2.0,
-        };
+        let tri = Triangle::new(
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.1, 0.0),
+            Vec3::new(0.2, 0.9, 0.1),
+            6.0,
+            2.0,
+        );
         let edge = Edge {
             a: Vec3::new(0.0, 0.0, 0.0),
             b: Vec3::new(1.0, 0.3, -0.2),

@@ -279,13 +279,13 @@ fn triangles(mesh: &Mesh) -> Option<(Vec<Triangle>, f64)> {
                 .max()
                 .unwrap_or(1)
                 .max(1);
-            Triangle {
-                a: mesh.vertices[t[0] as usize],
-                b: mesh.vertices[t[1] as usize],
-                c: mesh.vertices[t[2] as usize],
-                vmax: vmax as f32,
-                emax: emax as f32,
-            }
+            Triangle::new(
+                mesh.vertices[t[0] as usize],
+                mesh.vertices[t[1] as usize],
+                mesh.vertices[t[2] as usize],
+                vmax as f32,
+                emax as f32,
+            )
         })
         .collect();
     let max_v = vval.iter().copied().max().unwrap_or(1);

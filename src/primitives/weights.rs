@@ -127,13 +127,28 @@ pub fn triangle_coefficients(vmax: f64, emax: f64) -> [f64; 13] {
 const TABLE_VMAX: usize = 32;
 const TABLE_EMAX: usize = 8;
 
-/// [`triangle_coefficients`], from a table computed once for the common valences
-/// (`vmax <= 32`, `emax <= 8`), else into `buf`.
-#[inline]
-pub fn triangle_k(vmax: f32, emax: f32, buf: &mut [f64; 13]) -> &[f64; 13] {
-    static TABLE: std::sync::OnceLock<Vec<[f64; 13]>> = std::sync::OnceLock::new();
+/// Where [`triangle_k`] finds the coefficients of a triangle with valences `vmax`,
+/// `emax`: its row of the table of the common valences (`vmax <= 32`, `emax <= 8`), or
+/// [`NOT_TABULATED`]. Computed once per triangle (`primitives::Triangle`): the float
+/// to index conversions cost as much as a tenth of a term.
+pub fn triangle_table_row(vmax: f32, emax: f32) -> u16 {
     let (v, e) = (vmax as usize, emax as usize);
     if (1..=TABLE_VMAX).contains(&v) && (1..=TABLE_EMAX).contains(&e) {
+        ((v - 1) * TABLE_EMAX + (e - 1)) as u16
+    } else {
+        NOT_TABULATED
+    }
+}
+
+/// [`triangle_table_row`] of valences outside the table.
+pub const NOT_TABULATED: u16 = u16::MAX;
+
+/// [`triangle_coefficients`] for valences `vmax`, `emax` whose [`triangle_table_row`] is
+/// `row`: from a table computed once for the common valences, else into `buf`.
+#[inline]
+pub fn triangle_k(row: u16, vmax: f32, emax: f32, buf: &mut [f64; 13]) -> &[f64; 13] {
+    static TABLE: std::sync::OnceLock<Vec<[f64; 13]>> = std::sync::OnceLock::new();
+    if row != NOT_TABULATED {
         let table = TABLE.get_or_init(|| {
             (1..=TABLE_VMAX)
                 .flat_map(|v| {
@@ -141,7 +156,7 @@ pub fn triangle_k(vmax: f32, emax: f32, buf: &mut [f64; 13]) -> &[f64; 13] {
                 })
                 .collect()
         });
-        &table[(v - 1) * TABLE_EMAX + (e - 1)]
+        &table[row as usize]
     } else {
         *buf = triangle_coefficients(vmax as f64, emax as f64);
         buf
@@ -472,7 +487,7 @@ mod tests {
     fn value_path_matches_gradient_path_and_table() {
         let mut buf = [0.0; 13];
         for (v, e) in [(1.0f32, 1.0f32), (6.0, 2.0), (40.0, 3.0), (5.0, 12.0)] {
-            let k = *triangle_k(v, e, &mut buf);
+            let k = *triangle_k(triangle_table_row(v, e), v, e, &mut buf);
             assert_eq!(k, triangle_coefficients(v as f64, e as f64));
             for &(s, t) in &[(0.1, 0.2), (0.5, 0.5), (0.0, 1.0), (0.3, 0.0)] {
                 let a = triangle_w_value(s, t, &k);

@@ -474,12 +474,14 @@ mod tests {
         let mut seed = 3;
         let mut p = || glam::Vec3::new(lcg(&mut seed) as f32, lcg(&mut seed) as f32, 0.0);
         let prims: Vec<Triangle> = (0..20)
-            .map(|_| Triangle {
-                a: p(),
-                b: p() + glam::Vec3::Z * 0.3,
-                c: p() - glam::Vec3::Z * 0.2,
-                vmax: 1.0,
-                emax: 1.0,
+            .map(|_| {
+                Triangle::new(
+                    p(),
+                    p() + glam::Vec3::Z * 0.3,
+                    p() - glam::Vec3::Z * 0.2,
+                    1.0,
+                    1.0,
+                )
             })
             .collect();
         let mut seed = 9;
