@@ -12,8 +12,8 @@
 //! `hitcheck` (every pixel's ray traced by tiles, as renders trace them; the exact
 //! value, beta 0, at each hit point in epsilons: how far the hits sit from the exact
 //! zero set, and the share outside the hit band). A last argument `fixed-step-beta`
-//! turns the tiles' learned step beta (`render::step_beta`) off. `betas`: at points of the
-//! exact surface, how far each beta's sum lies below the exact value, and its leaves.
+//! turns the tiles' learned step beta (`render::step_beta`) off. `betas [B1,B2,...]`: at
+//! points of the exact surface, how far each beta's sum lies below the exact value, and its leaves.
 use glam::DVec3;
 use rayon::prelude::*;
 use smoothtrace::eval::evaluate_value;
@@ -90,7 +90,10 @@ fn main() {
             let r = evaluate_value(&sets, x, &p);
             (r.s / eps, r.stats.leaves(), (r.s_upper - r.s) / eps)
         };
-        let betas = [0.0, 0.1, 0.3, 0.5, 1.0, 4.0];
+        // The betas: a comma-separated list after `betas`, or these.
+        let betas: Vec<f64> = args.get(5).map_or(vec![0.0, 0.1, 0.3, 0.5, 1.0, 4.0], |a| {
+            a.split(',').map(|b| b.parse().expect("betas: a list like 0,0.3,0.5")).collect()
+        });
         let mut rows: Vec<Vec<(f64, u32, f64)>> = Vec::new();
         for py in (0..h).step_by(9) {
             for px in (0..w).step_by(9) {
