@@ -92,7 +92,9 @@ fn main() {
         };
         // The betas: a comma-separated list after `betas`, or these.
         let betas: Vec<f64> = args.get(5).map_or(vec![0.0, 0.1, 0.3, 0.5, 1.0, 4.0], |a| {
-            a.split(',').map(|b| b.parse().expect("betas: a list like 0,0.3,0.5")).collect()
+            a.split(',')
+                .map(|b| b.parse().expect("betas: a list like 0,0.3,0.5"))
+                .collect()
         });
         let mut rows: Vec<Vec<(f64, u32, f64)>> = Vec::new();
         for py in (0..h).step_by(9) {

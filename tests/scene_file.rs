@@ -69,6 +69,7 @@ epsilon = 1e-3
 max_steps = 500
 evaluation = "naive"
 threads = 2
+certified_hits = true
 
 [[object]]
 mesh = "../data/bunny.obj"
@@ -105,6 +106,7 @@ transform = { scale = [1, 2, 3] }
     assert_eq!(s.render.max_steps, 500);
     assert_eq!(s.render.evaluation, Evaluation::Naive);
     assert_eq!(s.render.threads, 2);
+    assert!(s.render.certified_hits);
     assert_eq!(s.objects.len(), 2);
 
     let bunny = &s.objects[0];
@@ -162,6 +164,7 @@ fn defaults() {
     assert_eq!(s.render.max_steps, 1000);
     assert_eq!(s.render.evaluation, Evaluation::Stable);
     assert_eq!(s.render.threads, 0);
+    assert!(!s.render.certified_hits);
     let o = &s.objects[0];
     assert_eq!(
         o.geometry,
@@ -408,6 +411,11 @@ fn wrong_types() {
     assert_mentions(&msg, &[":7:9:", "`alpha`", "expected a number"]);
     let msg = error(&minimal().replace("[0.0, 1.0, 5.0]", "[0.0, 1.0]"));
     assert_mentions(&msg, &[":2:10:", "`origin`", "length 2"]);
+    let msg = error(&format!(
+        "{}[render]\ncertified_hits = \"yes\"\n",
+        minimal()
+    ));
+    assert_mentions(&msg, &[":9:18:", "`certified_hits`", "expected a boolean"]);
     let msg = error(&format!("{}[render]\nevaluation = \"fast\"\n", minimal()));
     assert_mentions(
         &msg,

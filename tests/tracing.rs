@@ -553,6 +553,16 @@ fn certified_hits_put_a_soft_dense_mesh_on_its_exact_surface() {
         p50_plain > 10.0 * p50.max(1e-6),
         "the scene should need it: {p50_plain:e} at the hit beta against {p50:e}"
     );
+    // The scene's own key (`[render] certified_hits = true`) turns the same on.
+    let mut keyed = s.clone();
+    keyed.render.certified_hits = true;
+    let (_, _, by_key) = render(&keyed, |o| o);
+    let (_, _, by_option) = render(&s, |o| TracerOptions {
+        certified_hits: true,
+        ..o
+    });
+    // (The certified render differs from the plain one: the medians above.)
+    assert_eq!(by_key.depth, by_option.depth);
 }
 
 /// The evaluation's upper bound (`EvalParams::upper_bound`: far-field subtrees at their

@@ -77,6 +77,7 @@ pub fn render_object(object: TraceObject, image: &ImageRequest) -> Result<Render
         bounds,
         steps: Vec::new(),
         diagonals: vec![diagonal],
+        certified_hits: render.certified_hits,
     };
     let rendered = with_threads(image.threads, || {
         pipeline::render_built(&built, render.max_steps, image.background, |o| o, &|_| {})

@@ -290,9 +290,9 @@ pub fn run(a: RenderArgs) -> Result<()> {
     let outputs = check_outputs(&a, &film)?;
     film.keep_aovs = !outputs.aovs.is_empty();
     let (coarse_beta, certified_hits) = (a.coarse_beta, a.certified_hits);
-    let tracer_options = |o| TracerOptions {
+    let tracer_options = |o: TracerOptions| TracerOptions {
         coarse_beta,
-        certified_hits,
+        certified_hits: certified_hits || o.certified_hits,
         ..o
     };
     let label = a.scene.display().to_string();

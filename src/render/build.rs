@@ -4,6 +4,7 @@
 //! `--verbose` can show what was built.
 
 use super::object::TraceObject;
+use super::options::TracerOptions;
 use super::signed::SignedSurface;
 use crate::camera::{Camera, CameraError};
 use crate::colour::by_geometry::height_colours;
@@ -86,6 +87,19 @@ pub struct BuiltScene {
     /// Each object's bounding-box diagonal after its transform (what `alpha_rel` is
     /// relative to).
     pub diagonals: Vec<f64>,
+    /// The scene's `certified_hits` (`[render]`).
+    pub certified_hits: bool,
+}
+
+impl BuiltScene {
+    /// The tracer's defaults for this scene: its epsilon, `max_steps` and
+    /// `certified_hits`.
+    pub fn tracer_options(&self, max_steps: u32) -> TracerOptions {
+        TracerOptions {
+            certified_hits: self.certified_hits,
+            ..TracerOptions::new(self.epsilon, max_steps)
+        }
+    }
 }
 
 /// Builds every object of `scene`.
@@ -272,6 +286,7 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
         bounds,
         steps,
         diagonals,
+        certified_hits: scene.render.certified_hits,
     })
 }
 

@@ -85,7 +85,7 @@ pub fn render_view(
     progress: &(dyn Fn(u64) + Sync),
     cancelled: &(dyn Fn() -> bool + Sync),
 ) -> Option<Rendered> {
-    let opts = options(TracerOptions::new(built.epsilon, max_steps));
+    let opts = options(built.tracer_options(max_steps));
     let tracer = Tracer::new(&built.objects, opts);
     render_film(&tracer, camera, &built.shaders, film, progress, cancelled)
 }

@@ -282,7 +282,7 @@ fn run_row(
     let render = || {
         render_objects(
             &built.objects,
-            TracerOptions::new(built.epsilon, scene.render.max_steps),
+            built.tracer_options(scene.render.max_steps),
             &built.camera,
             &built.shaders,
             scene.image.background,

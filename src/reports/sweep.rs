@@ -203,7 +203,7 @@ pub fn run(
                 let options = if o.paper_mode {
                     TracerOptions::paper(built.epsilon, scene.render.max_steps)
                 } else {
-                    TracerOptions::new(built.epsilon, scene.render.max_steps)
+                    built.tracer_options(scene.render.max_steps)
                 };
                 let label = format!("{name} beta {beta}{}", if naive { " naive" } else { "" });
                 render_objects(

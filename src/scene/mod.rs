@@ -87,6 +87,9 @@ pub struct RenderSettings {
     pub aa: AaMode,
     /// `"box"` (default) or `"gaussian"`.
     pub filter: Filter,
+    /// Hits certified within one epsilon of the exact sum on edges and triangles
+    /// (`render::TracerOptions::certified_hits`, `render --certified-hits`); default off.
+    pub certified_hits: bool,
 }
 
 /// The sphere-tracing hit threshold.
@@ -239,6 +242,7 @@ impl Default for RenderSettings {
             samples: 1,
             aa: AaMode::Uniform,
             filter: Filter::Box,
+            certified_hits: false,
         }
     }
 }

@@ -53,6 +53,7 @@ pub(super) struct RawRender {
     pub samples: Option<Spanned<i64>>,
     pub aa: Option<Spanned<String>>,
     pub filter: Option<Spanned<String>>,
+    pub certified_hits: Option<bool>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -281,6 +281,7 @@ impl Resolver<'_> {
             samples,
             aa,
             filter,
+            certified_hits: raw.certified_hits.unwrap_or(false),
         })
     }
 

@@ -19,9 +19,9 @@ use crate::film::aov::AovBuffers;
 use crate::film::{FilmOptions, heatmap};
 use crate::matcap::{MatCap, MatCapSpec};
 use crate::primitives::PrimitiveKind;
+use crate::render::Tracer;
 use crate::render::build::{BuiltScene, build_scene, object_alphas};
 use crate::render::image::{ImageStats, Rendered, render_film};
-use crate::render::{Tracer, TracerOptions};
 use crate::scene::Scene;
 use serde::Serialize;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -190,10 +190,7 @@ impl Jobs {
             .build(w, h)
             .map_err(|e| ServeError::BadRequest(format!("camera: {e}")))?;
         self.with_built(scene, &cancelled, |built| {
-            let tracer = Tracer::new(
-                &built.objects,
-                TracerOptions::new(built.epsilon, scene.render.max_steps),
-            );
+            let tracer = Tracer::new(&built.objects, built.tracer_options(scene.render.max_steps));
             self.counters
                 .renders_started
                 .fetch_add(1, Ordering::Relaxed);
@@ -241,10 +238,7 @@ impl Jobs {
             .build(w, h)
             .map_err(|e| ServeError::BadRequest(format!("camera: {e}")))?;
         self.with_built(scene, &|| false, |built| {
-            let tracer = Tracer::new(
-                &built.objects,
-                TracerOptions::new(built.epsilon, scene.render.max_steps),
-            );
+            let tracer = Tracer::new(&built.objects, built.tracer_options(scene.render.max_steps));
             let (o, d) = camera.ray_through(x, y);
             let r = tracer.trace(o, d, 0.0);
             let mut probe = Probe {

@@ -88,6 +88,9 @@ pub fn scene_toml(scene: &Scene, folder: &Path) -> Result<String, SaveError> {
     if scene.render.threads != 0 {
         render.insert("threads".into(), (scene.render.threads as i64).into());
     }
+    if scene.render.certified_hits {
+        render.insert("certified_hits".into(), true.into());
+    }
     root.insert("render".into(), render.into());
     let mut objects = Vec::new();
     for (k, o) in scene.objects.iter().enumerate() {
