@@ -1,17 +1,23 @@
-//! The arithmetic of a query group ([`super::batch`]) over its [`GROUP`] lanes, written
-//! as loops over fixed-size arrays that the compiler vectorizes: with AVX2 and FMA when
-//! the processor has them (checked once per group at run time), else with the baseline
-//! instructions.
+//! The arithmetic of a query group ([`super::batch`]) over its [`GROUP`] lanes: with
+//! AVX2 and FMA intrinsics when the processor has them (checked at run time), else as
+//! loops over fixed-size arrays in the baseline instructions.
 //!
-//! - Far fields ([`super::expansion::FarPoly`]) at every lane, in f32 about the group's
-//!   first query (so the precision is that of the distances, not of the coordinates).
-//!   `1 / |r|` comes from the `rsqrt` estimate and one Newton step
-//!   `y (3 - d2 y^2) / 2` on AVX2 (relative error below 1e-6 instead of 2^-12; a far
-//!   field's terms carry `|r|^-2` to `|r|^-4`, so each is off by a few 1e-6 of itself,
-//!   far below the truncation error), and from `1 / sqrt` elsewhere.
+//! - Far fields ([`FarNode`]: a node's centre, squared radius and the polynomial
+//!   coefficients of [`super::expansion::FarPoly`] times `1 / (4 pi)`, in two aligned
+//!   cache lines) at every lane, in f32 about the group's first query (so the precision
+//!   is that of the distances, not of the coordinates). On AVX2 eight lanes at a time,
+//!   two such chunks per pass over the group's list: the lanes' coordinates and sums stay
+//!   in registers and each node's coefficients are broadcast from memory (the
+//!   compiler's own vectorization of all 32 lanes at once spilled its registers).
+//!   `1 / |r|` comes from the `rsqrt` estimate and one Newton step `y (3 - d2 y^2) / 2`
+//!   on AVX2 (relative error below 1e-6 instead of 2^-12; a far field's terms carry
+//!   `|r|^-2` to `|r|^-4`, so each is off by a few 1e-6 of itself, far below the
+//!   truncation error), and from `1 / sqrt` elsewhere.
+//! - [`all_far`]: whether every lane's query meets a node's criterion
+//!   `R^2 < beta^2 |r|^2` (the walk's second chance for a node the group's box refuses).
 //! - Leaves near the group: the same far field where a lane's own query meets the
-//!   criterion `R^2 < beta^2 |r|^2`, and the lanes where it does not are listed with the
-//!   leaf's triangles for the exact solid angles.
+//!   criterion, and the lanes where it does not are listed with the leaf's triangles for
+//!   the exact solid angles.
 //! - Exact solid angles ([`super::exact::solid_angle`]) over a list of (lane, triangle)
 //!   pairs, in f64 with [`atan2`]: Cephes' `atan` (Moshier, a
 //!   rational approximation on `[0, 0.66]`, relative error about 1e-16) after the
