@@ -26,7 +26,8 @@ use std::f64::consts::PI;
 #[derive(Clone, Debug, Default)]
 pub struct WindingTree {
     pub far: Vec<FarField>,
-    /// The same far fields as polynomials for batch queries (`super::batch`).
+    /// The same far fields as the batch's lanes read them (`super::lanes`: centre,
+    /// radius and polynomial coefficients in 128 bytes).
     pub poly: Vec<FarNode>,
     /// What the batch walk reads per node, in 24 bytes.
     pub walk: Vec<WalkNode>,
