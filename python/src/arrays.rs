@@ -73,7 +73,12 @@ pub fn kinds(names: &[String]) -> PyResult<Vec<PrimitiveKind>> {
         .collect()
 }
 
-/// Query points from an `(n, 3)` array (finite coordinates).
+/// Query points from an `(n, 3)` array (finite coordinates); a C-contiguous array is
+/// read in place (no copy before the conversion).
 pub fn points(p: &PyReadonlyArray2<'_, f64>, name: &str) -> PyResult<Vec<DVec3>> {
+    let view = p.as_array();
+    if let (3, Some(flat)) = (view.shape()[1], view.as_slice()) {
+        return points_from_array(flat, name).map_err(to_py);
+    }
     points_from_array(&rows(p, name, 3)?, name).map_err(to_py)
 }

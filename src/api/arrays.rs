@@ -5,6 +5,7 @@
 use super::InputError;
 use crate::mesh::Mesh;
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
 /// A mesh from `vertices` (flat `(n, 3)`), `triangles` (flat `(m, 3)`) and `segments`
 /// (flat `(k, 2)`). `names` are the arrays' names for messages (vertices, triangles,
@@ -45,23 +46,40 @@ pub fn mesh_from_arrays(
 /// the command line's query limit ([`crate::limits::MAX_QUERY_COORD`]): beyond it the
 /// f64 squared distances overflow (issue 32: `[1e200, 0, 0]` gave `inf`, a zero gradient
 /// and a NaN closest point).
+///
+/// The checks and the conversion run in parallel (in the current rayon pool); the error
+/// names the first bad row, non-finite values first, as one pass in order would.
 pub fn points_from_array(values: &[f64], name: &str) -> Result<Vec<DVec3>, InputError> {
-    let points = finite_points(values, name)?;
-    for (row, p) in points.iter().enumerate() {
-        if let Some(problem) = p
-            .to_array()
-            .iter()
+    if !values.len().is_multiple_of(3) {
+        return Err(InputError::Shape {
+            array: name.to_string(),
+            len: values.len(),
+            width: 3,
+        });
+    }
+    let rows = values.par_chunks_exact(3);
+    let row_value = |row: usize| [values[3 * row], values[3 * row + 1], values[3 * row + 2]];
+    // `None` for a good row (the limits' check also refuses NaN and infinities).
+    let problem = |c: &[f64]| {
+        c.iter()
             .find_map(|&v| crate::limits::query_coordinate_problem(v))
-        {
-            return Err(InputError::QueryOutOfRange {
+    };
+    if let Some(row) = rows.clone().position_first(|c| problem(c).is_some()) {
+        if let Some(row) = rows.position_first(|c| !c.iter().all(|v| v.is_finite())) {
+            return Err(InputError::NonFinite {
                 array: name.to_string(),
                 row,
-                value: p.to_array(),
-                problem,
+                value: row_value(row),
             });
         }
+        return Err(InputError::QueryOutOfRange {
+            array: name.to_string(),
+            row,
+            value: row_value(row),
+            problem: problem(&row_value(row)).unwrap_or_default(),
+        });
     }
-    Ok(points)
+    Ok(rows.map(|c| DVec3::new(c[0], c[1], c[2])).collect())
 }
 
 /// Points from a flat `(n, 3)` array with finite coordinates (vertices: their own
@@ -188,5 +206,26 @@ mod tests {
         );
         assert!(points_from_array(&[-1e31, 5e30, 0.0], "P").is_ok());
         assert!(points_from_array(&[0.0, 2e31, 0.0], "P").is_err());
+    }
+
+    #[test]
+    fn query_point_errors_name_the_first_bad_row_non_finite_first() {
+        let mut v = vec![0.5; 3 * 5000];
+        v[3 * 4000 + 1] = f64::INFINITY;
+        v[3 * 3000] = 1e200;
+        v[3 * 4500 + 2] = f64::NAN;
+        let e = points_from_array(&v, "P").unwrap_err().to_string();
+        assert!(e.starts_with("P[4000] has a non-finite"), "{e}");
+        v[3 * 4000 + 1] = 0.0;
+        v[3 * 4500 + 2] = 0.0;
+        v[3 * 3500] = -1e100;
+        let e = points_from_array(&v, "P").unwrap_err().to_string();
+        assert!(e.starts_with("P[3000]"), "{e}");
+        v[3 * 3000] = 0.0;
+        v[3 * 3500] = 0.0;
+        let p = points_from_array(&v, "P").unwrap();
+        assert_eq!(p.len(), 5000);
+        assert_eq!(p[4999], DVec3::splat(0.5));
+        assert!(points_from_array(&v[..7], "P").is_err());
     }
 }

@@ -15,7 +15,8 @@
 //! counts, however far.
 
 use super::exact::solid_angle;
-use super::expansion::{FarField, FarPoly, Moments};
+use super::expansion::{FarField, Moments};
+use super::lanes::FarNode;
 use crate::bvh::Node;
 use crate::primitives::{PrimitiveSet, Triangle};
 use glam::DVec3;
@@ -25,8 +26,34 @@ use std::f64::consts::PI;
 #[derive(Clone, Debug, Default)]
 pub struct WindingTree {
     pub far: Vec<FarField>,
-    /// The same far fields as polynomials for batch queries (`super::batch`).
-    pub poly: Vec<FarPoly>,
+    /// The same far fields as the batch's lanes read them (`super::lanes`: centre,
+    /// radius and polynomial coefficients in 128 bytes).
+    pub poly: Vec<FarNode>,
+    /// What the batch walk reads per node, in 24 bytes.
+    pub walk: Vec<WalkNode>,
+}
+
+/// A node as the batch walk reads it (`super::batch`): the far field's centre and
+/// squared radius (as in [`FarField`]), and the BVH node's `index` and `count` (leaf:
+/// first triangle and number of triangles; inner: right child and 0).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WalkNode {
+    pub centre: [f32; 3],
+    pub r2: f32,
+    pub index: u32,
+    pub count: u32,
+}
+
+impl WalkNode {
+    /// The centre in f64.
+    #[inline]
+    pub fn centre(&self) -> DVec3 {
+        DVec3::new(
+            self.centre[0] as f64,
+            self.centre[1] as f64,
+            self.centre[2] as f64,
+        )
+    }
 }
 
 impl WindingTree {
@@ -61,13 +88,25 @@ impl WindingTree {
                 .fold(0.0f64, f64::max);
             f.r2 = grow(r2) as f32;
         });
-        let poly = far.par_iter().map(FarPoly::new).collect();
-        WindingTree { far, poly }
+        let poly = far.par_iter().map(FarNode::new).collect();
+        let walk = far
+            .iter()
+            .zip(nodes)
+            .map(|(f, n)| WalkNode {
+                centre: f.centre,
+                r2: f.r2,
+                index: n.index,
+                count: n.count,
+            })
+            .collect();
+        WindingTree { far, poly, walk }
     }
 
     /// Heap memory, bytes.
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of_val(self.far.as_slice()) + std::mem::size_of_val(self.poly.as_slice())
+        std::mem::size_of_val(self.far.as_slice())
+            + std::mem::size_of_val(self.poly.as_slice())
+            + std::mem::size_of_val(self.walk.as_slice())
     }
 
     /// The winding number of `set` (the set this tree was built from) at `q`, with the
