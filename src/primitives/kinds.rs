@@ -157,7 +157,8 @@ impl Primitive for Edge {
     }
 }
 
-/// A triangle with its largest vertex and edge valences (degree-7 weight, SPEC 4).
+/// A triangle with its largest vertex and edge valences (degree-7 weight, SPEC 4). Made
+/// by [`Triangle::new`], which also decides `order` and `row` once for every query.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Triangle {
     pub a: Vec3,
