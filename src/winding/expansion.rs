@@ -175,11 +175,7 @@ impl FarField {
     /// The centre in f64.
     #[inline]
     pub fn centre(&self) -> DVec3 {
-        DVec3::new(
-            self.centre[0] as f64,
-            self.centre[1] as f64,
-            self.centre[2] as f64,
-        )
+        glam::Vec3::from_array(self.centre).as_dvec3()
     }
 
     /// The second-order far-field winding number at the query `q` with `r = centre - q`

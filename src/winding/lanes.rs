@@ -141,8 +141,7 @@ impl FarNode {
     /// The centre in f64.
     #[inline]
     pub fn centre(&self) -> DVec3 {
-        let c = self.centre;
-        DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)
+        glam::Vec3::from_array(self.centre).as_dvec3()
     }
 
     /// The centre relative to `origin`, in f32.
@@ -410,34 +409,14 @@ mod avx2 {
             let (xx, xy, xz) = (mul(x, x), mul(x, y), mul(x, z));
             let (yy, yz, zz) = (mul(y, y), mul(y, z), mul(z, z));
             let order0 = fma(b(p.n[0]), x, fma(b(p.n[1]), y, mul(b(p.n[2]), z)));
-            let a = &p.a;
-            let order1 = fma(
-                b(a[0]),
-                xx,
-                fma(
-                    b(a[1]),
-                    xy,
-                    fma(
-                        b(a[2]),
-                        xz,
-                        fma(b(a[3]), yy, fma(b(a[4]), yz, fma(b(a[5]), zz, b(p.trace)))),
-                    ),
-                ),
-            );
+            // `c0 xx + c1 xy + c2 xz + c3 yy + c4 yz + c5 zz + tail`, by fused steps.
+            let form = |c: &[f32], tail| {
+                let q = fma(b(c[3]), yy, fma(b(c[4]), yz, fma(b(c[5]), zz, tail)));
+                fma(b(c[0]), xx, fma(b(c[1]), xy, fma(b(c[2]), xz, q)))
+            };
+            let order1 = form(&p.a, b(p.trace));
             let c3 = &p.cubic;
-            let cx = fma(
-                b(c3[0]),
-                xx,
-                fma(
-                    b(c3[1]),
-                    xy,
-                    fma(
-                        b(c3[2]),
-                        xz,
-                        fma(b(c3[3]), yy, fma(b(c3[4]), yz, mul(b(c3[5]), zz))),
-                    ),
-                ),
-            );
+            let cx = form(&c3[..6], _mm256_setzero_ps());
             let cy = fma(b(c3[6]), yy, fma(b(c3[7]), yz, mul(b(c3[8]), zz)));
             let cubic = fma(x, cx, fma(y, cy, mul(mul(b(c3[9]), zz), z)));
             let order2 = fma(b(p.g[0]), x, fma(b(p.g[1]), y, fma(b(p.g[2]), z, cubic)));

@@ -48,11 +48,7 @@ impl WalkNode {
     /// The centre in f64.
     #[inline]
     pub fn centre(&self) -> DVec3 {
-        DVec3::new(
-            self.centre[0] as f64,
-            self.centre[1] as f64,
-            self.centre[2] as f64,
-        )
+        glam::Vec3::from_array(self.centre).as_dvec3()
     }
 }
 
