@@ -241,18 +241,34 @@ pub fn triangle_w_directional(s: f64, t: f64, ds: f64, dt: f64, k: &[f64; 13]) -
 }
 
 /// Triangle weight polynomial and its partials `(W, dW/ds, dW/dt)` with coefficients `k`.
+/// The basis of [`tri_basis`] grouped as `W = k0 + f(s) + f(t) + s^2 t^2 h(s, t)`, with
+/// the one-variable part `f(x) = k1 x^2 + k2 x^3 + k3 x^4 + k5 x^5 + k7 x^6 + k10 x^7` and
+/// `h = k4 + k6 (s+t) + k8 (s^2+t^2) + k9 st + k11 (s^3+t^3) + k12 st (s+t)`, each in
+/// Horner form: `dW/ds = f'(s) + 2 s t^2 h + s^2 t^2 dh/ds` (and `t` likewise). A third
+/// of the arithmetic of summing the 13 basis functions and their two partials.
 #[inline]
 pub fn triangle_w_grad(s: f64, t: f64, k: &[f64; 13]) -> (f64, f64, f64) {
-    let (bs, dbs) = tri_basis(s, t);
-    let (_, dbt) = tri_basis(t, s);
-    let mut w = 0.0;
-    let mut ws = 0.0;
-    let mut wt = 0.0;
-    for i in 0..13 {
-        w += k[i] * bs[i];
-        ws += k[i] * dbs[i];
-        wt += k[i] * dbt[i];
-    }
+    let f = |x: f64| x * x * (k[1] + x * (k[2] + x * (k[3] + x * (k[5] + x * (k[7] + x * k[10])))));
+    let df = |x: f64| {
+        x * (2.0 * k[1]
+            + x * (3.0 * k[2]
+                + x * (4.0 * k[3] + x * (5.0 * k[5] + x * (6.0 * k[7] + x * 7.0 * k[10])))))
+    };
+    let (s2, t2, st) = (s * s, t * t, s * t);
+    let q = s2 * t2;
+    let h = k[4]
+        + k[6] * (s + t)
+        + k[8] * (s2 + t2)
+        + k[9] * st
+        + k[11] * (s2 * s + t2 * t)
+        + k[12] * st * (s + t);
+    // dh/ds and dh/dt share everything but their own variable's terms.
+    let common = k[6] + 2.0 * k[12] * st;
+    let hs = common + 2.0 * k[8] * s + k[9] * t + 3.0 * k[11] * s2 + k[12] * t2;
+    let ht = common + 2.0 * k[8] * t + k[9] * s + 3.0 * k[11] * t2 + k[12] * s2;
+    let w = k[0] + f(s) + f(t) + q * h;
+    let ws = df(s) + 2.0 * s * t2 * h + q * hs;
+    let wt = df(t) + 2.0 * t * s2 * h + q * ht;
     (w, ws, wt)
 }
 
@@ -460,6 +476,40 @@ mod tests {
             let ft =
                 (triangle_w(s, t + h, 7.0, 2.0).0 - triangle_w(s, t - h, 7.0, 2.0).0) / (2.0 * h);
             assert!((ws - fs).abs() < 1e-6 && (wt - ft).abs() < 1e-6);
+        }
+    }
+
+    /// The grouped Horner form of `triangle_w_grad` is the sum of the 13 basis functions
+    /// and of their partials, for coefficient sets of the table and arbitrary ones.
+    #[test]
+    fn grouped_partials_are_the_basis_sums() {
+        let mut seed = 3u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut sets = vec![
+            triangle_coefficients(6.0, 2.0),
+            triangle_coefficients(11.0, 3.0),
+        ];
+        sets.push(std::array::from_fn(|_| 0.0));
+        let arbitrary: [f64; 13] = std::array::from_fn(|_| 20.0 * rnd() - 10.0);
+        sets.push(arbitrary);
+        for k in &sets {
+            for _ in 0..200 {
+                let s = rnd();
+                let t = (1.0 - s) * rnd();
+                let (bs, dbs) = tri_basis(s, t);
+                let (_, dbt) = tri_basis(t, s);
+                let dot = |b: &[f64; 13]| b.iter().zip(k).map(|(b, k)| b * k).sum::<f64>();
+                let (w, ws, wt) = triangle_w_grad(s, t, k);
+                let scale = 1.0 + k.iter().map(|v| v.abs()).sum::<f64>();
+                assert!((w - dot(&bs)).abs() <= 1e-13 * scale, "{s} {t}");
+                assert!((ws - dot(&dbs)).abs() <= 1e-12 * scale, "{s} {t}");
+                assert!((wt - dot(&dbt)).abs() <= 1e-12 * scale, "{s} {t}");
+            }
         }
     }
 
