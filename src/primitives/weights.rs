@@ -244,8 +244,8 @@ pub fn triangle_w_directional(s: f64, t: f64, ds: f64, dt: f64, k: &[f64; 13]) -
 /// The basis of [`tri_basis`] grouped as `W = k0 + f(s) + f(t) + s^2 t^2 h(s, t)`, with
 /// the one-variable part `f(x) = k1 x^2 + k2 x^3 + k3 x^4 + k5 x^5 + k7 x^6 + k10 x^7` and
 /// `h = k4 + k6 (s+t) + k8 (s^2+t^2) + k9 st + k11 (s^3+t^3) + k12 st (s+t)`, each in
-/// Horner form: `dW/ds = f'(s) + 2 s t^2 h + s^2 t^2 dh/ds` (and `t` likewise). A third
-/// of the arithmetic of summing the 13 basis functions and their two partials.
+/// Horner form: `dW/ds = f'(s) + 2 s t^2 h + s^2 t^2 dh/ds` (and `t` likewise): less
+/// than half the arithmetic of summing the 13 basis functions and their two partials.
 #[inline]
 pub fn triangle_w_grad(s: f64, t: f64, k: &[f64; 13]) -> (f64, f64, f64) {
     let f = |x: f64| x * x * (k[1] + x * (k[2] + x * (k[3] + x * (k[5] + x * (k[7] + x * k[10])))));
