@@ -490,13 +490,13 @@ mod tests {
                 .wrapping_add(1_442_695_040_888_963_407);
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        let mut sets = vec![
+        let arbitrary: [f64; 13] = std::array::from_fn(|_| 20.0 * rnd() - 10.0);
+        let sets = [
             triangle_coefficients(6.0, 2.0),
             triangle_coefficients(11.0, 3.0),
+            [0.0; 13],
+            arbitrary,
         ];
-        sets.push(std::array::from_fn(|_| 0.0));
-        let arbitrary: [f64; 13] = std::array::from_fn(|_| 20.0 * rnd() - 10.0);
-        sets.push(arbitrary);
         for k in &sets {
             for _ in 0..200 {
                 let s = rnd();
