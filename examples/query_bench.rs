@@ -80,6 +80,7 @@ fn main() {
         max_alpha: None,
         max_alpha_rel: None,
         beta,
+        tolerance: None,
     };
     let mut object = queries::build_object(&mesh, &spec, Naming::Keyword).expect("object");
     object.params.prune_tolerance = arg("--tol", object.params.prune_tolerance);

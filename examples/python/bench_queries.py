@@ -8,9 +8,14 @@ stores the mesh and the queries in float32; its distances are checked against ou
 (largest difference relative to the diagonal). Without Open3D (`pip install open3d`)
 its columns are skipped, saying why.
 
+`value` is timed at the default pruning and at each `--tolerance-rel` (how far pruning
+may lower the value, relative to the diagonal: `SmoothDistance(..., tolerance=)`), with
+the largest difference from the default's values.
+
 Run:
     python examples/python/bench_queries.py [MESH] [--n-near 500000] [--n-box 1000000]
-        [--alpha-rel 1000,3000] [--beta 0.5] [--threads 2] [--repeat 3] [--json F] [--csv F]
+        [--alpha-rel 1000,3000] [--tolerance-rel 1e-7] [--beta 0.5] [--threads 2]
+        [--repeat 3] [--json F] [--csv F]
 """
 
 import argparse
@@ -27,6 +32,7 @@ ap.add_argument("mesh", nargs="?", default="data/bunny.obj")
 ap.add_argument("--n-near", type=int, default=500_000)
 ap.add_argument("--n-box", type=int, default=1_000_000)
 ap.add_argument("--alpha-rel", default="1000,3000")
+ap.add_argument("--tolerance-rel", default="1e-7")
 ap.add_argument("--beta", type=float, default=0.5)
 ap.add_argument("--threads", type=int, default=2)
 ap.add_argument("--repeat", type=int, default=3)
@@ -77,9 +83,16 @@ for kind, P in points.items():
         row["max_diff_rel_diag"] = float(np.abs(d3 - d).max() / diag)
     for r in [float(x) for x in a.alpha_rel.split(",")]:
         sd = st.SmoothDistance(V, faces=F, alpha_rel=r, beta=a.beta)
-        t_val, _ = best_of(lambda: sd.value(P, threads=a.threads))
+        t_val, s_default = best_of(lambda: sd.value(P, threads=a.threads))
         row[f"value_s_alpha_rel_{r:g}"] = round(t_val, 4)
         row[f"value_over_nearest_alpha_rel_{r:g}"] = round(t_val / t_near, 2)
+        for tr in [float(x) for x in a.tolerance_rel.split(",") if x]:
+            sd_t = st.SmoothDistance(V, faces=F, alpha_rel=r, beta=a.beta, tolerance=tr * diag)
+            t_t, s_t = best_of(lambda: sd_t.value(P, threads=a.threads))
+            key = f"alpha_rel_{r:g}_tolerance_rel_{tr:g}"
+            row[f"value_s_{key}"] = round(t_t, 4)
+            row[f"value_over_nearest_{key}"] = round(t_t / t_near, 2)
+            row[f"max_diff_rel_diag_{key}"] = float(np.abs(s_t - s_default).max() / diag)
     rows.append(row)
     print(", ".join(f"{k} {v}" for k, v in row.items()), flush=True)
 if open3d_why:

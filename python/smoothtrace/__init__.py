@@ -198,6 +198,12 @@ class SmoothDistance:
         Weight attenuation threshold (SPEC 5); default ``alpha``.
     beta : float
         Barnes-Hut opening parameter in [0, 1]; 0 is the exact sum. Default 0.5.
+    tolerance : float, optional
+        How far pruning (skipping subtrees too far to matter) may lower the smooth
+        distance at most, in the mesh's units; 0 turns pruning off. Default: subtrees
+        holding together 1e-10 of the sum, within ``2e-10 / alpha``. A looser one is
+        faster near the surface: on the full Stanford bunny at ``alpha_rel=1000``,
+        ``1e-7 * diagonal`` took :meth:`value` 2.5x less time (README, "Python").
 
     Only the requested sets are built (with their BVHs), as in the command line.
     """
@@ -213,6 +219,7 @@ class SmoothDistance:
         max_alpha: Optional[float] = None,
         max_alpha_rel: Optional[float] = None,
         beta: float = 0.5,
+        tolerance: Optional[float] = None,
     ) -> None:
         kinds = _primitives(primitives, faces, edges)
         a, ar, m, mr = _alpha_args(alpha, alpha_rel, max_alpha, max_alpha_rel)
@@ -227,6 +234,7 @@ class SmoothDistance:
             m,
             mr,
             0.5 if beta_value is None else beta_value,
+            _number(tolerance, "tolerance"),
         )
 
     def value(self, P: Any, threads: Optional[int] = None) -> np.ndarray:

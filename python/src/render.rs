@@ -102,6 +102,7 @@ pub fn render_arrays<'py>(
             max_alpha,
             max_alpha_rel,
             beta,
+            tolerance: None,
         };
         let request = ImageRequest {
             width: check_image_size("width", width).map_err(to_py)?,

@@ -33,7 +33,7 @@ type Arr2<'py> = Bound<'py, PyArray2<f64>>;
 #[pymethods]
 impl SmoothDistance {
     #[new]
-    #[pyo3(signature = (vertices, faces, edges, primitives, alpha, alpha_rel, max_alpha, max_alpha_rel, beta))]
+    #[pyo3(signature = (vertices, faces, edges, primitives, alpha, alpha_rel, max_alpha, max_alpha_rel, beta, tolerance=None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -46,6 +46,7 @@ impl SmoothDistance {
         max_alpha: Option<f64>,
         max_alpha_rel: Option<f64>,
         beta: f64,
+        tolerance: Option<f64>,
     ) -> PyResult<SmoothDistance> {
         guard(|| {
             let m = mesh(&vertices, faces.as_ref(), edges.as_ref())?;
@@ -56,6 +57,7 @@ impl SmoothDistance {
                 max_alpha,
                 max_alpha_rel,
                 beta,
+                tolerance,
             };
             py.detach(|| {
                 let object = queries::build_object(&m, &spec, Naming::Keyword)?;

@@ -81,6 +81,36 @@ pub fn check_beta(naming: Naming, beta: f64) -> Result<f64, InputError> {
     Ok(beta)
 }
 
+/// Largest share of the sum a query's pruning may skip (the tracer's cap, `render::tracer`).
+pub const MAX_PRUNE_SHARE: f64 = 1e-2;
+
+/// The pruning of queries from `tolerance`, how far it may lower the smooth distance at
+/// most (a length, in the mesh's units; `eval::smooth`: subtrees holding together a share
+/// `tol` of the sum lower it by at most `2 tol / alpha`): `tol = alpha tolerance / 2`,
+/// at most [`MAX_PRUNE_SHARE`]; 0 turns pruning off (the Barnes-Hut sum itself). `None`
+/// keeps the default share ([`crate::eval::params::PRUNE_TOLERANCE`]).
+pub fn apply_tolerance(
+    naming: Naming,
+    tolerance: Option<f64>,
+    params: &mut crate::eval::EvalParams,
+) -> Result<(), InputError> {
+    let Some(t) = tolerance else {
+        return Ok(());
+    };
+    if !(t >= 0.0 && t.is_finite()) {
+        return Err(bad(format!(
+            "{} must be a length >= 0 (got {t})",
+            naming.name("tolerance")
+        )));
+    }
+    if t == 0.0 {
+        params.prune = false;
+    } else {
+        params.prune_tolerance = (0.5 * params.alpha * t).min(MAX_PRUNE_SHARE);
+    }
+    Ok(())
+}
+
 /// A worker-thread count in `0..=MAX_THREADS` (0 = all cores).
 pub fn check_threads(name: &str, threads: i64) -> Result<usize, InputError> {
     if !(0..=MAX_THREADS).contains(&threads) {

@@ -3,7 +3,7 @@
 //! the exact nearest primitive, evaluated in parallel in the current rayon pool.
 
 use super::InputError;
-use super::params::{Naming, check_beta, resolve_alpha};
+use super::params::{Naming, apply_tolerance, check_beta, resolve_alpha};
 use crate::eval::{self, EvalParams, Nearest};
 use crate::geometry::morton::morton_order;
 use crate::mesh::Mesh;
@@ -24,6 +24,9 @@ pub struct ObjectSpec {
     pub max_alpha: Option<f64>,
     pub max_alpha_rel: Option<f64>,
     pub beta: f64,
+    /// How far pruning may lower the smooth distance at most (a length; 0: no pruning;
+    /// default: a share 1e-10 of the sum, `params::apply_tolerance`).
+    pub tolerance: Option<f64>,
 }
 
 /// Builds the primitive sets `spec` names (and nothing else) with their BVHs, and
@@ -64,10 +67,9 @@ pub fn build_object(
             sets.push(AnySet::build(mesh, kind)?);
         }
     }
-    Ok(TraceObject::new(
-        sets,
-        EvalParams::new(alpha, max_alpha, beta),
-    ))
+    let mut params = EvalParams::new(alpha, max_alpha, beta);
+    apply_tolerance(naming, spec.tolerance, &mut params)?;
+    Ok(TraceObject::new(sets, params))
 }
 
 /// Queries per batch along the Morton curve (in [`nearest`] each starts from its
@@ -166,6 +168,7 @@ mod tests {
             max_alpha: None,
             max_alpha_rel: None,
             beta: 0.0,
+            tolerance: None,
         };
         let obj = build_object(&mesh, &spec, Naming::Keyword).unwrap();
         assert_eq!(obj.params.alpha, 20.0 / 2f64.sqrt());
@@ -233,6 +236,7 @@ mod tests {
                 max_alpha: None,
                 max_alpha_rel: None,
                 beta: 0.5,
+                tolerance: None,
             };
             let obj = build_object(&mesh, &spec, Naming::Keyword).unwrap();
             let sets = obj.set_refs();
@@ -252,6 +256,99 @@ mod tests {
     }
 
     #[test]
+    fn a_tolerance_bounds_what_pruning_takes() {
+        // A soup of 300 small triangles in the unit cube, queries near and inside it.
+        let mut seed = 29u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut v = Vec::new();
+        let mut f = Vec::new();
+        for t in 0..300 {
+            let c = [rnd(), rnd(), rnd()];
+            for _ in 0..3 {
+                v.extend(c.iter().map(|&a| a + 0.05 * (rnd() - 0.5)));
+            }
+            f.extend([3 * t, 3 * t + 1, 3 * t + 2]);
+        }
+        let mesh = super::super::arrays::mesh_from_arrays(&v, &f, &[], ["V", "F", "E"]).unwrap();
+        let pts: Vec<DVec3> = (0..400)
+            .map(|_| DVec3::new(rnd(), rnd(), rnd()) * 1.2 - 0.1)
+            .collect();
+        let spec = |alpha: f64, beta: f64, tolerance: Option<f64>| ObjectSpec {
+            kinds: vec![PrimitiveKind::Triangles],
+            alpha: Some(alpha),
+            alpha_rel: None,
+            max_alpha: None,
+            max_alpha_rel: None,
+            beta,
+            tolerance,
+        };
+        for alpha in [20.0, 200.0] {
+            // No pruning at beta 0: the exact sum.
+            let exact = build_object(&mesh, &spec(alpha, 0.0, Some(0.0)), Naming::Keyword).unwrap();
+            assert!(!exact.params.prune);
+            let s0 = values(&exact, &pts);
+            let sets = exact.set_refs();
+            for (i, &x) in pts.iter().enumerate() {
+                let (bs, _, _) = brute::smooth_distance(&sets, x, alpha, alpha);
+                assert!(
+                    (s0[i] - bs).abs() <= 1e-12 * bs.abs().max(1.0),
+                    "{} vs {bs}",
+                    s0[i]
+                );
+            }
+            for beta in [0.0, 0.5] {
+                let unpruned = values(
+                    &build_object(&mesh, &spec(alpha, beta, Some(0.0)), Naming::Keyword).unwrap(),
+                    &pts,
+                );
+                for tolerance in [1e-6, 1e-4, 1e-2] {
+                    let obj =
+                        build_object(&mesh, &spec(alpha, beta, Some(tolerance)), Naming::Keyword)
+                            .unwrap();
+                    let s = values(&obj, &pts);
+                    // Where the share is not capped, pruning takes most of what it may
+                    // (93-96% here): the bound is the tolerance, not a multiple of it.
+                    let most = (0..pts.len())
+                        .map(|i| unpruned[i] - s[i])
+                        .fold(0.0, f64::max);
+                    if 0.5 * alpha * tolerance < super::super::params::MAX_PRUNE_SHARE {
+                        assert!(
+                            most >= 0.5 * tolerance,
+                            "alpha {alpha} beta {beta} tol {tolerance}: {most}"
+                        );
+                    }
+                    for i in 0..pts.len() {
+                        // Below the unpruned sum (a lower bound still), by at most the tolerance.
+                        let (a, b) = (s[i], unpruned[i]);
+                        let round = 1e-12 * b.abs().max(1.0);
+                        assert!(
+                            a <= b + round,
+                            "alpha {alpha} beta {beta} tol {tolerance}: {a} > {b}"
+                        );
+                        assert!(
+                            b - a <= tolerance + round,
+                            "alpha {alpha} beta {beta} tol {tolerance}: {a} vs {b}"
+                        );
+                    }
+                }
+            }
+        }
+        for bad in [-1e-3, f64::NAN, f64::INFINITY] {
+            let e = build_object(&mesh, &spec(1.0, 0.5, Some(bad)), Naming::Flag)
+                .err()
+                .unwrap();
+            assert!(
+                e.to_string()
+                    .starts_with("--tolerance must be a length >= 0"),
+                "{e}"
+            );
+        }
+    }
+
+    #[test]
     fn missing_alpha_and_empty_kinds_are_named() {
         let mesh = square();
         let mut spec = ObjectSpec {
@@ -261,6 +358,7 @@ mod tests {
             max_alpha: None,
             max_alpha_rel: None,
             beta: 0.5,
+            tolerance: None,
         };
         let e = build_object(&mesh, &spec, Naming::Keyword).err().unwrap();
         assert!(e.to_string().starts_with("primitives is empty"), "{e}");

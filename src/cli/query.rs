@@ -46,6 +46,10 @@ pub struct QueryArgs {
     /// Barnes-Hut opening parameter in [0, 1] (0 = exact sum).
     #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
     beta: f64,
+    /// How far pruning may lower the smooth distance at most (a length; 0 = no pruning;
+    /// default: a share 1e-10 of the sum, within 2e-10 / alpha).
+    #[arg(long, allow_negative_numbers = true)]
+    tolerance: Option<f64>,
     /// Use the paper's naive (unshifted) accumulation; prints inf where it underflows.
     #[arg(long)]
     naive: bool,
@@ -82,6 +86,7 @@ pub fn run(a: QueryArgs) -> Result<()> {
     let alpha = resolve("alpha", a.alpha, a.alpha_rel)?.context("give --alpha or --alpha-rel")?;
     let max_alpha = resolve("max_alpha", a.max_alpha, a.max_alpha_rel)?.unwrap_or(alpha);
     let mut params = EvalParams::new(alpha, max_alpha, a.beta);
+    params::apply_tolerance(Naming::Flag, a.tolerance, &mut params)?;
     if a.naive {
         params.accumulation = Accumulation::Naive;
     }

@@ -85,6 +85,9 @@ def test_bad_queries(mesh):
         (dict(), "give alpha or alpha_rel"),
         (dict(alpha=1.0, alpha_rel=2.0), "give alpha or alpha_rel, not both"),
         (dict(alpha="1"), "alpha must be a number"),
+        (dict(alpha=1.0, tolerance=-1e-3), r"tolerance must be a length >= 0 \(got -0.001\)"),
+        (dict(alpha=1.0, tolerance=float("nan")), r"tolerance must be a length >= 0 \(got NaN\)"),
+        (dict(alpha=1.0, tolerance="small"), "tolerance must be a number"),
     ],
 )
 def test_bad_parameters(mesh, kwargs, match):

@@ -77,6 +77,23 @@ def test_beta_gives_a_lower_bound_below_the_nearest_distance(torus_mesh, rng):
     np.testing.assert_allclose(s, s5, rtol=1e-12, atol=1e-14)
 
 
+def test_a_tolerance_bounds_what_pruning_takes(torus_mesh, rng):
+    # tolerance=0 sums every term (the exact sum at beta 0); a tolerance t lowers the
+    # value by at most t, and the pruning takes most of it somewhere.
+    V, F = torus_mesh
+    P = queries(V, 300, rng, 0.1)
+    exact = st.SmoothDistance(V, faces=F, alpha_rel=100, beta=0.0, tolerance=0.0)
+    s0 = exact.value(P)
+    default = st.SmoothDistance(V, faces=F, alpha_rel=100, beta=0.0).value(P)
+    assert close(default, s0, exact.alpha).all()
+    diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+    for t in (1e-8 * diag, 1e-6 * diag):
+        s = st.SmoothDistance(V, faces=F, alpha_rel=100, beta=0.0, tolerance=t).value(P)
+        assert (s <= s0 + 1e-12 * np.abs(s0)).all()
+        assert (s0 - s <= t * (1 + 1e-9)).all()
+        assert (s0 - s).max() >= 0.5 * t
+
+
 @pytest.mark.parametrize("kind", ["points", "edges", "triangles"])
 def test_gradients_match_central_differences(torus_mesh, rng, kind):
     V, F = torus_mesh
