@@ -158,6 +158,29 @@ mod tests {
             .unwrap()
     }
 
+    /// A stream of uniform numbers in [0, 1) from `seed` (a linear congruential generator).
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// `n` separate triangles at random places in the unit cube, their vertices within
+    /// `size / 2` of a random centre each.
+    fn soup(n: u32, size: f64, rnd: &mut impl FnMut() -> f64) -> Mesh {
+        let mut v = Vec::new();
+        let mut f = Vec::new();
+        for t in 0..n as i64 {
+            let c = [rnd(), rnd(), rnd()];
+            for _ in 0..3 {
+                v.extend(c.iter().map(|&a| a + size * (rnd() - 0.5)));
+            }
+            f.extend([3 * t, 3 * t + 1, 3 * t + 2]);
+        }
+        super::super::arrays::mesh_from_arrays(&v, &f, &[], ["V", "F", "E"]).unwrap()
+    }
+
     #[test]
     fn batch_values_match_single_queries_and_brute_force() {
         let mesh = square();
@@ -204,21 +227,8 @@ mod tests {
     fn batch_nearest_matches_brute_force_on_a_soup_in_any_order() {
         // 200 random triangles (their edges and vertices too), queries near and far
         // given in random order: the Morton batches and their hints change nothing.
-        let mut seed = 17u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut v = Vec::new();
-        let mut f = Vec::new();
-        for t in 0..200 {
-            let c = [rnd(), rnd(), rnd()];
-            for _ in 0..3 {
-                v.extend(c.iter().map(|&a| a + 0.1 * (rnd() - 0.5)));
-            }
-            f.extend([3 * t, 3 * t + 1, 3 * t + 2]);
-        }
-        let mesh = super::super::arrays::mesh_from_arrays(&v, &f, &[], ["V", "F", "E"]).unwrap();
+        let mut rnd = uniform(17);
+        let mesh = soup(200, 0.1, &mut rnd);
         let pts: Vec<DVec3> = (0..3000)
             .map(|i| {
                 let s = if i % 3 == 0 { 3.0 } else { 1.2 };
@@ -258,21 +268,8 @@ mod tests {
     #[test]
     fn a_tolerance_bounds_what_pruning_takes() {
         // A soup of 300 small triangles in the unit cube, queries near and inside it.
-        let mut seed = 29u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut v = Vec::new();
-        let mut f = Vec::new();
-        for t in 0..300 {
-            let c = [rnd(), rnd(), rnd()];
-            for _ in 0..3 {
-                v.extend(c.iter().map(|&a| a + 0.05 * (rnd() - 0.5)));
-            }
-            f.extend([3 * t, 3 * t + 1, 3 * t + 2]);
-        }
-        let mesh = super::super::arrays::mesh_from_arrays(&v, &f, &[], ["V", "F", "E"]).unwrap();
+        let mut rnd = uniform(29);
+        let mesh = soup(300, 0.05, &mut rnd);
         let pts: Vec<DVec3> = (0..400)
             .map(|_| DVec3::new(rnd(), rnd(), rnd()) * 1.2 - 0.1)
             .collect();
