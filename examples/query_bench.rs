@@ -6,8 +6,8 @@
 //! kinds of points.
 //!
 //! Run: `cargo run --release --example query_bench -- [MESH] [--n N] [--where near|box]
-//! [--alpha-rel R] [--beta B] [--repeat K]` (defaults: data/bunny.obj, 500,000, near,
-//! 1000, 0.5, 3).
+//! [--alpha-rel R] [--beta B] [--repeat K] [--tol SHARE]` (defaults: data/bunny.obj,
+//! 500,000, near, 1000, 0.5, 3, 1e-10).
 
 use glam::DVec3;
 use smoothtrace::api::params::Naming;
@@ -83,6 +83,7 @@ fn main() {
         tolerance: None,
     };
     let mut object = queries::build_object(&mesh, &spec, Naming::Keyword).expect("object");
+    // `--tol`: the share of the sum pruning may skip (`EvalParams::prune_tolerance`).
     object.params.prune_tolerance = arg("--tol", object.params.prune_tolerance);
     let p = points(&mesh, n, near);
     let (t_near, nn) = best(repeat, || queries::nearest(&object, &p));

@@ -163,6 +163,11 @@ fn query_bad_input_exits_2_with_a_clear_message() {
     let mut a = with("t.obj", "points");
     a.extend(["--points".into(), "badq.txt".into()]);
     e(a, &["badq.txt:2", "three numbers"]);
+    for bad in ["-0.001", "nan", "inf"] {
+        let mut a = with("t.obj", "triangles");
+        a.extend(["--tolerance".into(), bad.into()]);
+        e(a, &["--tolerance must be a length >= 0"]);
+    }
 }
 
 const SCENE: &str = r#"

@@ -92,7 +92,7 @@ pub fn run(a: QueryArgs) -> Result<()> {
     }
     let n: usize = sets.iter().map(|s| s.len()).sum();
     note!(
-        "{}: {} {} ({} primitives), diagonal {diag}, alpha {alpha} (alpha * diagonal = {}), max_alpha {max_alpha}, beta {}, {} accumulation",
+        "{}: {} {} ({} primitives), diagonal {diag}, alpha {alpha} (alpha * diagonal = {}), max_alpha {max_alpha}, beta {}, {}, {} accumulation",
         a.mesh.display(),
         mesh.name,
         a.primitive
@@ -103,6 +103,14 @@ pub fn run(a: QueryArgs) -> Result<()> {
         n,
         alpha * diag,
         a.beta,
+        if params.prune {
+            format!(
+                "pruning lowers s by at most {:.3e}",
+                2.0 * params.prune_tolerance / alpha
+            )
+        } else {
+            "no pruning".to_string()
+        },
         if a.naive { "naive" } else { "stable" },
     );
     let solid = if a.signed {
