@@ -2,6 +2,7 @@
 //! messages in both; only the way a parameter is named differs ([`Naming`]).
 
 use super::InputError;
+use crate::eval::params::MAX_PRUNE_TOLERANCE;
 use crate::scene::{AlphaSpec, MAX_IMAGE_SIZE, Scene};
 
 /// Largest accepted worker-thread count.
@@ -81,13 +82,10 @@ pub fn check_beta(naming: Naming, beta: f64) -> Result<f64, InputError> {
     Ok(beta)
 }
 
-/// Largest share of the sum a query's pruning may skip (the tracer's cap, `render::tracer`).
-pub const MAX_PRUNE_SHARE: f64 = 1e-2;
-
 /// The pruning of queries from `tolerance`, how far it may lower the smooth distance at
 /// most (a length, in the mesh's units; `eval::smooth`: subtrees holding together a share
 /// `tol` of the sum lower it by at most `2 tol / alpha`): `tol = alpha tolerance / 2`,
-/// at most [`MAX_PRUNE_SHARE`]; 0 turns pruning off (the Barnes-Hut sum itself). `None`
+/// at most [`MAX_PRUNE_TOLERANCE`] (as the tracer's); 0 turns pruning off (the Barnes-Hut sum itself). `None`
 /// keeps the default share ([`crate::eval::params::PRUNE_TOLERANCE`]).
 pub fn apply_tolerance(
     naming: Naming,
@@ -106,7 +104,7 @@ pub fn apply_tolerance(
     if t == 0.0 {
         params.prune = false;
     } else {
-        params.prune_tolerance = (0.5 * params.alpha * t).min(MAX_PRUNE_SHARE);
+        params.prune_tolerance = (0.5 * params.alpha * t).min(MAX_PRUNE_TOLERANCE);
     }
     Ok(())
 }

@@ -311,7 +311,7 @@ mod tests {
                     let most = (0..pts.len())
                         .map(|i| unpruned[i] - s[i])
                         .fold(0.0, f64::max);
-                    if 0.5 * alpha * tolerance < super::super::params::MAX_PRUNE_SHARE {
+                    if 0.5 * alpha * tolerance < crate::eval::params::MAX_PRUNE_TOLERANCE {
                         assert!(
                             most >= 0.5 * tolerance,
                             "alpha {alpha} beta {beta} tol {tolerance}: {most}"

@@ -104,10 +104,7 @@ pub fn run(a: QueryArgs) -> Result<()> {
         alpha * diag,
         a.beta,
         if params.prune {
-            format!(
-                "pruning lowers s by at most {:.3e}",
-                2.0 * params.prune_tolerance / alpha
-            )
+            format!("pruning lowers s by at most {:.3e}", params.pruning_bound())
         } else {
             "no pruning".to_string()
         },

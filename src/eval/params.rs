@@ -13,6 +13,10 @@ use super::accumulate::Accumulation;
 /// matters, and pruning more is what makes soft point clouds cheaper.
 pub const PRUNE_TOLERANCE: f64 = 1e-10;
 
+/// The largest share a caller asks for: the tracer's tolerance tied to epsilon and a
+/// query's tolerance given as a length (`api::params::apply_tolerance`) stop here.
+pub const MAX_PRUNE_TOLERANCE: f64 = 1e-2;
+
 /// Share of the tolerance the first pruning rule takes when a budget is kept; the budget
 /// takes the rest of `2 tol` (module docs).
 const FIRST_RULE_SHARE: f64 = 0.25;
@@ -67,6 +71,15 @@ impl EvalParams {
             moments: true,
             upper_bound: false,
             budget: true,
+        }
+    }
+
+    /// How far pruning may lower `s` at most: `2 prune_tolerance / alpha` (0 when off).
+    pub fn pruning_bound(&self) -> f64 {
+        if self.prune {
+            2.0 * self.prune_tolerance / self.alpha
+        } else {
+            0.0
         }
     }
 }

@@ -106,6 +106,7 @@ use super::object::TraceObject;
 use super::options::{Backtrack, TracerOptions};
 use super::step_beta::StepBeta;
 use super::stepper::{Kind, Stepper};
+use crate::eval::params::MAX_PRUNE_TOLERANCE;
 use crate::eval::{Along, EvalStats};
 use crate::primitives::AnySet;
 use glam::DVec3;
@@ -176,10 +177,9 @@ const PREDICT_AT_HIT_BETA: f64 = 4.0;
 /// docs, item 11).
 const GAP_MAX: f64 = 1.0;
 
-/// The tracer's pruning tolerance is `min(PRUNE_SHARE alpha epsilon, PRUNE_CAP)` (module
-/// docs, item 6): values lower by at most `2 PRUNE_SHARE epsilon`.
+/// The tracer's pruning tolerance is `min(PRUNE_SHARE alpha epsilon, MAX_PRUNE_TOLERANCE)`
+/// (module docs, item 6): values lower by at most `2 PRUNE_SHARE epsilon`.
 const PRUNE_SHARE: f64 = 0.025;
-const PRUNE_CAP: f64 = 1e-2;
 
 /// The final step's longest reach, in units of the hit's value `s` (module docs, item
 /// 4): a ray that meets the surface at a slope of 1/2 or more (30 degrees) crosses it
@@ -255,7 +255,7 @@ impl<'a> Tracer<'a> {
         }
         let tolerance = objects
             .iter()
-            .map(|o| (PRUNE_SHARE * o.params.alpha * options.epsilon).min(PRUNE_CAP))
+            .map(|o| (PRUNE_SHARE * o.params.alpha * options.epsilon).min(MAX_PRUNE_TOLERANCE))
             .collect();
         // Objects made of points only: hits at the scene's beta (item 9), coarser steps
         // (item 10) and an earlier end of the bound steps (item 5).
