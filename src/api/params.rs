@@ -84,9 +84,10 @@ pub fn check_beta(naming: Naming, beta: f64) -> Result<f64, InputError> {
 
 /// The pruning of queries from `tolerance`, how far it may lower the smooth distance at
 /// most (a length, in the mesh's units; `eval::smooth`: subtrees holding together a share
-/// `tol` of the sum lower it by at most `2 tol / alpha`): `tol = alpha tolerance / 2`,
-/// at most [`MAX_PRUNE_TOLERANCE`] (as the tracer's); 0 turns pruning off (the Barnes-Hut sum itself). `None`
-/// keeps the default share ([`crate::eval::params::PRUNE_TOLERANCE`]).
+/// `tol` of the sum lower it by at most `2 tol / alpha`, `EvalParams::pruning_bound`):
+/// `tol = alpha tolerance / 2`, at most [`MAX_PRUNE_TOLERANCE`] (as the tracer's); 0
+/// turns pruning off (the Barnes-Hut sum itself). `None` keeps the default share
+/// ([`crate::eval::params::PRUNE_TOLERANCE`]).
 pub fn apply_tolerance(
     naming: Naming,
     tolerance: Option<f64>,
