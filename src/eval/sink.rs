@@ -5,7 +5,7 @@
 
 use super::accumulate::Accumulator;
 use super::reach::Slopes;
-use crate::primitives::{Primitive, WeightScale};
+use crate::primitives::{Primitive, Term, WeightScale};
 use glam::DVec3;
 
 /// `g(z) = (e^z - 1 - z) / z^2` for `z >= 0`, from above (to a relative 1e-11): its
@@ -202,22 +202,68 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
         }
     }
 
+    /// The exact terms of a leaf's primitives (at most `leaf_size` of them): in fours
+    /// from the primitive's batch where it has one (`Primitive::BATCHED`), else one by
+    /// one; added in the same order either way.
+    #[inline]
+    pub fn exact_leaf<P: Primitive>(&mut self, prims: &[P], x: DVec3, scale: &WeightScale) {
+        if !P::BATCHED {
+            for prim in prims {
+                self.exact(prim, x, scale);
+            }
+            return;
+        }
+        for chunk in prims.chunks(4) {
+            if GRAD {
+                let mut out = [Term::default(); 4];
+                P::terms(chunk, x, scale, &mut out);
+                for t in &out[..chunk.len()] {
+                    self.exact_term(t);
+                }
+            } else if SLOPE {
+                let mut out = [(0.0, 0.0, 0.0, 0.0); 4];
+                P::value_slopes(chunk, x, self.u, scale, &mut out);
+                for &(d, w, a, l) in &out[..chunk.len()] {
+                    self.exact_value_slope(d, w, a, l);
+                }
+            } else {
+                let mut out = [(0.0, 0.0); 4];
+                P::values(chunk, x, scale, &mut out);
+                for &(d, w) in &out[..chunk.len()] {
+                    self.acc.add_value(d, w);
+                }
+            }
+        }
+    }
+
+    /// An exact term computed with its gradient (`GRAD`).
+    #[inline]
+    fn exact_term(&mut self, t: &Term) {
+        let m = self.acc.m;
+        let e = self.acc.add(t.d, t.w, t.dir, t.grad_w);
+        if SLOPE {
+            let a = self.term_slope(t.dir.dot(self.u), t.grad_w.dot(self.u) / t.w);
+            self.add_slope(m, e, a);
+        }
+    }
+
+    /// An exact term's value and slopes (`SLOPE` without `GRAD`).
+    #[inline]
+    fn exact_value_slope(&mut self, d: f64, w: f64, a: f64, l: f64) {
+        let m = self.acc.m;
+        let e = self.acc.add_value(d, w);
+        let a = self.term_slope(a, l);
+        self.add_slope(m, e, a);
+    }
+
     /// A primitive's exact term.
     #[inline]
-    pub fn exact<P: Primitive>(&mut self, prim: &P, x: DVec3, scale: &WeightScale) {
-        let m = self.acc.m;
+    fn exact<P: Primitive>(&mut self, prim: &P, x: DVec3, scale: &WeightScale) {
         if GRAD {
-            let t = prim.term(x, scale);
-            let e = self.acc.add(t.d, t.w, t.dir, t.grad_w);
-            if SLOPE {
-                let a = self.term_slope(t.dir.dot(self.u), t.grad_w.dot(self.u) / t.w);
-                self.add_slope(m, e, a);
-            }
+            self.exact_term(&prim.term(x, scale));
         } else if SLOPE {
             let (d, w, a, l) = prim.value_slope(x, self.u, scale);
-            let e = self.acc.add_value(d, w);
-            let a = self.term_slope(a, l);
-            self.add_slope(m, e, a);
+            self.exact_value_slope(d, w, a, l);
         } else {
             let (d, w) = prim.value(x, scale);
             self.acc.add_value(d, w);

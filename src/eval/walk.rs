@@ -320,9 +320,8 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             }
             if e.count > 0 {
                 let first = e.i as usize;
-                for prim in &self.set.prims[first..first + e.count as usize] {
-                    self.sink.exact(prim, self.x, self.scale);
-                }
+                let prims = &self.set.prims[first..first + e.count as usize];
+                self.sink.exact_leaf(prims, self.x, self.scale);
                 self.stats.exact += e.count;
                 continue;
             }

@@ -11,6 +11,9 @@ use crate::geometry::closest::{
 use crate::mesh::Aabb;
 use glam::{DVec3, Vec3};
 
+/// `(d, w, a, l)` of [`Primitive::value_slope`].
+pub type Slope = (f64, f64, f64, f64);
+
 /// One term of the smooth sum at a query point `x`.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Term {
@@ -34,6 +37,32 @@ pub trait Primitive: Copy + Send + Sync + 'static {
     fn closest_point(&self, x: DVec3) -> DVec3;
     /// The full term, with the direction and the weight gradient.
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term;
+    /// The evaluator takes a leaf's terms from [`Primitive::terms`], [`Primitive::values`]
+    /// and [`Primitive::value_slopes`] (four at a time) rather than one by one: true
+    /// where they compute several side by side (triangles and edges, `primitives::lanes`).
+    const BATCHED: bool = false;
+    /// [`Primitive::term`] of 1 ..= 4 primitives (a leaf's) into `out[..prims.len()]`,
+    /// with the same results.
+    #[inline]
+    fn terms(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [Term; 4]) {
+        for (o, p) in out.iter_mut().zip(prims) {
+            *o = p.term(x, scale);
+        }
+    }
+    /// [`Primitive::value`] of 1 ..= 4 primitives into `out[..prims.len()]`.
+    #[inline]
+    fn values(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [(f64, f64); 4]) {
+        for (o, p) in out.iter_mut().zip(prims) {
+            *o = p.value(x, scale);
+        }
+    }
+    /// [`Primitive::value_slope`] of 1 ..= 4 primitives into `out[..prims.len()]`.
+    #[inline]
+    fn value_slopes(prims: &[Self], x: DVec3, u: DVec3, scale: &WeightScale, out: &mut [Slope; 4]) {
+        for (o, p) in out.iter_mut().zip(prims) {
+            *o = p.value_slope(x, u, scale);
+        }
+    }
     /// `(d, w)` only: what a value-only evaluation (sphere-tracing steps) needs.
     fn value(&self, x: DVec3, scale: &WeightScale) -> (f64, f64);
     /// `(d, w, a, l)` with `a = u . (x - c) / d` the slope of the distance along unit `u`
@@ -111,6 +140,24 @@ pub struct Edge {
 }
 
 impl Primitive for Edge {
+    const BATCHED: bool = true;
+    #[inline]
+    fn terms(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [Term; 4]) {
+        super::lanes::edge_terms(prims, x, scale, out)
+    }
+    #[inline]
+    fn values(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [(f64, f64); 4]) {
+        super::lanes::edge_values(prims, x, scale, out)
+    }
+    /// From the terms, as [`Primitive::value_slope`]'s default does.
+    #[inline]
+    fn value_slopes(prims: &[Self], x: DVec3, u: DVec3, scale: &WeightScale, out: &mut [Slope; 4]) {
+        let mut terms = [Term::default(); 4];
+        Self::terms(prims, x, scale, &mut terms);
+        for (o, t) in out.iter_mut().zip(&terms[..prims.len()]) {
+            *o = (t.d, t.w, t.dir.dot(u), t.grad_w.dot(u) / t.w);
+        }
+    }
     fn bounds(&self) -> Aabb {
         Aabb {
             min: self.a.min(self.b),
@@ -216,6 +263,19 @@ impl Triangle {
 }
 
 impl Primitive for Triangle {
+    const BATCHED: bool = true;
+    #[inline]
+    fn terms(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [Term; 4]) {
+        super::lanes::triangle_terms(prims, x, scale, out)
+    }
+    #[inline]
+    fn values(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [(f64, f64); 4]) {
+        super::lanes::triangle_values(prims, x, scale, out)
+    }
+    #[inline]
+    fn value_slopes(prims: &[Self], x: DVec3, u: DVec3, scale: &WeightScale, out: &mut [Slope; 4]) {
+        super::lanes::triangle_value_slopes(prims, x, u, scale, out)
+    }
     fn bounds(&self) -> Aabb {
         Aabb {
             min: self.a.min(self.b).min(self.c),

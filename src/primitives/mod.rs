@@ -4,10 +4,11 @@
 use serde::Deserialize;
 
 mod kinds;
+pub mod lanes;
 mod sets;
 pub mod weights;
 
-pub use kinds::{Edge, Point, Primitive, Term, Triangle};
+pub use kinds::{Edge, Point, Primitive, Slope, Term, Triangle};
 pub use sets::{AnySet, BuildTimes, PrimitiveError, PrimitiveSet};
 pub use weights::WeightScale;
 
