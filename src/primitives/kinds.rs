@@ -39,7 +39,7 @@ pub trait Primitive: Copy + Send + Sync + 'static {
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term;
     /// The evaluator takes a leaf's terms from [`Primitive::terms`], [`Primitive::values`]
     /// and [`Primitive::value_slopes`] (four at a time) rather than one by one: true
-    /// where they compute several side by side (triangles and edges, `primitives::lanes`).
+    /// where they compute several side by side (edges, `primitives::lanes`).
     const BATCHED: bool = false;
     /// [`Primitive::term`] of 1 ..= 4 primitives (a leaf's) into `out[..prims.len()]`,
     /// with the same results.
@@ -263,19 +263,6 @@ impl Triangle {
 }
 
 impl Primitive for Triangle {
-    const BATCHED: bool = true;
-    #[inline]
-    fn terms(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [Term; 4]) {
-        super::lanes::triangle_terms(prims, x, scale, out)
-    }
-    #[inline]
-    fn values(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [(f64, f64); 4]) {
-        super::lanes::triangle_values(prims, x, scale, out)
-    }
-    #[inline]
-    fn value_slopes(prims: &[Self], x: DVec3, u: DVec3, scale: &WeightScale, out: &mut [Slope; 4]) {
-        super::lanes::triangle_value_slopes(prims, x, u, scale, out)
-    }
     fn bounds(&self) -> Aabb {
         Aabb {
             min: self.a.min(self.b).min(self.c),

@@ -14,6 +14,7 @@
 //! gradient of the smooth distance agrees with finite differences.
 
 use glam::DVec3;
+use std::ops::{Add, Mul, Sub};
 
 /// Coefficients of the degree-7 triangle weight (SPEC 4), `k = A/vmax + B/emax +
 /// C (vmax-1)/vmax`, in the basis listed in [`tri_basis`].
@@ -277,24 +278,43 @@ pub fn triangle_w(s: f64, t: f64, vmax: f64, emax: f64) -> (f64, f64, f64) {
     triangle_w_grad(s, t, &triangle_coefficients(vmax, emax))
 }
 
+/// What the edge weight's polynomial needs of a number: `f64`, or four of them in the
+/// lanes of `primitives::lanes`, which evaluate the same formulas (each operation rounds
+/// as on `f64`, so the lanes' weights equal the scalar ones to the last bit). Constant
+/// factors are written on the right (`x * 2.0`): an IEEE product or sum does not depend
+/// on the order of its two operands.
+pub trait Real:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Mul<f64, Output = Self>
+{
+    /// The constant `v`.
+    fn lit(v: f64) -> Self;
+}
+
+impl Real for f64 {
+    #[inline(always)]
+    fn lit(v: f64) -> f64 {
+        v
+    }
+}
+
 /// Coefficients `(c0, c2, c3, c4)` of the edge quartic `W(t) = c0 + c2 t² + c3 t³ + c4 t⁴`
 /// with `W(0) = a`, `W(1) = b`, `W(1/2) = 1`, `W'(0) = W'(1) = 0` (SPEC 4), where
 /// `a = 1/val(v0)`, `b = 1/val(v1)`. Solved in closed form: with `D = b - a` and
 /// `E = 16 (1 - a)`: `c2 = E - 5D`, `c3 = 14D - 2E`, `c4 = E - 8D`. An isolated edge
 /// (`a = b = 1`) gets `W = 1`.
-#[inline]
-pub fn edge_quartic(a: f64, b: f64) -> [f64; 4] {
+#[inline(always)]
+pub fn edge_quartic<T: Real>(a: T, b: T) -> [T; 4] {
     let d = b - a;
-    let e = 16.0 * (1.0 - a);
-    [a, e - 5.0 * d, 14.0 * d - 2.0 * e, e - 8.0 * d]
+    let e = (T::lit(1.0) - a) * 16.0;
+    [a, e - d * 5.0, d * 14.0 - e * 2.0, e - d * 8.0]
 }
 
 /// Edge weight polynomial value and derivative at `t`.
-#[inline]
-pub fn edge_w(t: f64, c: [f64; 4]) -> (f64, f64) {
+#[inline(always)]
+pub fn edge_w<T: Real>(t: T, c: [T; 4]) -> (T, T) {
     let t2 = t * t;
     let w = c[0] + t2 * (c[1] + t * (c[2] + t * c[3]));
-    let dw = t * (2.0 * c[1] + t * (3.0 * c[2] + t * 4.0 * c[3]));
+    let dw = t * (c[1] * 2.0 + t * (c[2] * 3.0 + t * 4.0 * c[3]));
     (w, dw)
 }
 

@@ -4,10 +4,10 @@
 //! The operations are `inline(always)` and reach the intrinsics only inside the
 //! kernels, which enable AVX (`target_feature`), where they inline.
 
-use crate::primitives::WeightScale;
+use crate::primitives::weights::{Real, WeightScale};
 use glam::DVec3;
 use std::arch::x86_64::*;
-use std::ops::{Add, Div, Mul, Neg, Sub};
+use std::ops::{Add, Div, Mul, Sub};
 
 // The lane types' operations are `inline(always)` and reach the AVX intrinsics only
 // inside the `target_feature(enable = "avx")` kernels below, where they inline.
@@ -79,18 +79,7 @@ impl Mul<V> for F {
         }
     }
 }
-/// `v * k` and `v / k` (glam's `DVec3 * f64`, `DVec3 / f64`).
-impl Mul<F> for V {
-    type Output = V;
-    #[inline(always)]
-    fn mul(self, k: F) -> V {
-        V {
-            x: self.x * k,
-            y: self.y * k,
-            z: self.z * k,
-        }
-    }
-}
+/// `v / k` (glam's `DVec3 / f64`).
 impl Div<F> for V {
     type Output = V;
     #[inline(always)]
@@ -102,23 +91,16 @@ impl Div<F> for V {
         }
     }
 }
-impl Neg for V {
-    type Output = V;
+impl Real for F {
     #[inline(always)]
-    fn neg(self) -> V {
-        let z = F::splat(-0.0);
-        // Flips the sign bits, as scalar negation does.
-        V {
-            x: z.xor(self.x),
-            y: z.xor(self.y),
-            z: z.xor(self.z),
-        }
+    fn lit(v: f64) -> F {
+        F::splat(v)
     }
 }
 
 /// Every bit set.
 #[inline(always)]
-fn unsafe_all_ones() -> __m256d {
+fn all_ones() -> __m256d {
     // SAFETY: called only from the AVX kernels.
     unsafe { _mm256_castsi256_pd(_mm256_set1_epi64x(-1)) }
 }
@@ -169,11 +151,6 @@ impl F {
         F(unsafe { _mm256_cmp_pd::<_CMP_GT_OQ>(self.0, o.0) })
     }
     #[inline(always)]
-    pub(super) fn eq(self, o: F) -> F {
-        // SAFETY: called only from the AVX kernels.
-        F(unsafe { _mm256_cmp_pd::<_CMP_EQ_OQ>(self.0, o.0) })
-    }
-    #[inline(always)]
     pub(super) fn ne(self, o: F) -> F {
         // SAFETY: called only from the AVX kernels.
         F(unsafe { _mm256_cmp_pd::<_CMP_NEQ_UQ>(self.0, o.0) })
@@ -190,7 +167,7 @@ impl F {
     }
     #[inline(always)]
     pub(super) fn not(self) -> F {
-        self.xor(F(unsafe_all_ones()))
+        self.xor(F(all_ones()))
     }
     #[inline(always)]
     pub(super) fn or(self, o: F) -> F {

@@ -3,7 +3,7 @@
 
 use super::avx::{F, V, apply};
 use crate::primitives::kinds::{Edge, Term};
-use crate::primitives::weights::WeightScale;
+use crate::primitives::weights::{self, WeightScale};
 use glam::DVec3;
 
 /// Four edges' closest points to `x` (`geometry::closest::closest_on_segment`, each
@@ -45,14 +45,8 @@ fn closest(edges: &[Edge], x: DVec3) -> Closest {
     let interior = at_a.or(at_b).not();
     let t = at_a.sel(zero, at_b.sel(one, tr));
     let p = at_a.sel3(a, at_b.sel3(b, a + t * ab));
-    // weights::edge_quartic(1 / val_a, 1 / val_b) and weights::edge_w.
-    let (qa, qb) = (one / F::load(&val[0]), one / F::load(&val[1]));
-    let dq = qb - qa;
-    let e = 16.0 * (one - qa);
-    let c = [qa, e - 5.0 * dq, 14.0 * dq - 2.0 * e, e - 8.0 * dq];
-    let t2 = t * t;
-    let raw = c[0] + t2 * (c[1] + t * (c[2] + t * c[3]));
-    let draw = t * (2.0 * c[1] + t * (3.0 * c[2] + t * 4.0 * c[3]));
+    let c = weights::edge_quartic(one / F::load(&val[0]), one / F::load(&val[1]));
+    let (raw, draw) = weights::edge_w(t, c);
     let v = xv - p;
     Closest {
         ab,
