@@ -4,6 +4,7 @@
 //! weight needs, so the evaluator touches one contiguous array in BVH order. Distances,
 //! closest points and weights are computed in f64.
 
+use super::lanes::{self, EdgeLanes, Lanes3, TermLanes};
 use super::weights::{self, WeightScale};
 use crate::geometry::closest::{
     TriangleClosest, closest_on_segment, closest_on_triangle_ordered, triangle_order,
@@ -45,16 +46,12 @@ pub trait Primitive: Copy + Send + Sync + 'static {
     /// with the same results.
     #[inline]
     fn terms(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [Term; 4]) {
-        for (o, p) in out.iter_mut().zip(prims) {
-            *o = p.term(x, scale);
-        }
+        scalar_terms(prims, x, scale, out)
     }
     /// [`Primitive::value`] of 1 ..= 4 primitives into `out[..prims.len()]`.
     #[inline]
     fn values(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [(f64, f64); 4]) {
-        for (o, p) in out.iter_mut().zip(prims) {
-            *o = p.value(x, scale);
-        }
+        scalar_values(prims, x, scale, out)
     }
     /// [`Primitive::value_slope`] of 1 ..= 4 primitives into `out[..prims.len()]`.
     #[inline]
@@ -75,6 +72,46 @@ pub trait Primitive: Copy + Send + Sync + 'static {
     }
 }
 
+/// [`Primitive::terms`] one by one.
+#[inline]
+fn scalar_terms<P: Primitive>(prims: &[P], x: DVec3, scale: &WeightScale, out: &mut [Term; 4]) {
+    for (o, p) in out.iter_mut().zip(prims) {
+        *o = p.term(x, scale);
+    }
+}
+
+/// [`Primitive::values`] one by one.
+#[inline]
+fn scalar_values<P: Primitive>(
+    prims: &[P],
+    x: DVec3,
+    scale: &WeightScale,
+    out: &mut [(f64, f64); 4],
+) {
+    for (o, p) in out.iter_mut().zip(prims) {
+        *o = p.value(x, scale);
+    }
+}
+
+/// Lane `l` of four 3-vectors.
+#[inline]
+fn lane3(v: &Lanes3, l: usize) -> DVec3 {
+    DVec3::new(v[0][l], v[1][l], v[2][l])
+}
+
+/// The first `n` of four terms computed in lanes.
+#[inline]
+fn fill_terms(t: &TermLanes, out: &mut [Term; 4], n: usize) {
+    for (l, o) in out.iter_mut().enumerate().take(n) {
+        *o = Term {
+            d: t.d[l],
+            dir: lane3(&t.dir, l),
+            w: t.w[l],
+            grad_w: lane3(&t.grad_w, l),
+        };
+    }
+}
+
 /// The slope `u . v / d` of a distance `d = |v|` along unit `u` (0 where `d = 0`).
 #[inline]
 fn slope(v: DVec3, d: f64, u: DVec3) -> f64 {
@@ -92,8 +129,65 @@ pub struct Point {
     pub p: Vec3,
 }
 
+impl Point {
+    /// Up to four points' coordinates in lanes (unused lanes repeat the last).
+    #[inline]
+    fn lanes(prims: &[Point]) -> Lanes3 {
+        let mut p = [[0.0; 4]; 3];
+        for l in 0..4 {
+            for (k, &c) in prims[l.min(prims.len() - 1)].p.as_ref().iter().enumerate() {
+                p[k][l] = c as f64;
+            }
+        }
+        p
+    }
+}
+
 impl Primitive for Point {
     const IS_POINT: bool = true;
+    const BATCHED: bool = true;
+    #[inline]
+    fn terms(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [Term; 4]) {
+        match lanes::point_terms(&Point::lanes(prims), x) {
+            Some((d, dir)) => {
+                for (l, o) in out.iter_mut().enumerate().take(prims.len()) {
+                    *o = Term {
+                        d: d[l],
+                        dir: lane3(&dir, l),
+                        w: 1.0,
+                        grad_w: DVec3::ZERO,
+                    };
+                }
+            }
+            None => scalar_terms(prims, x, scale, out),
+        }
+    }
+    #[inline]
+    fn values(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [(f64, f64); 4]) {
+        match lanes::point_values(&Point::lanes(prims), x) {
+            Some(d) => {
+                for (l, o) in out.iter_mut().enumerate().take(prims.len()) {
+                    *o = (d[l], 1.0);
+                }
+            }
+            None => scalar_values(prims, x, scale, out),
+        }
+    }
+    #[inline]
+    fn value_slopes(prims: &[Self], x: DVec3, u: DVec3, scale: &WeightScale, out: &mut [Slope; 4]) {
+        match lanes::point_value_slopes(&Point::lanes(prims), x, u) {
+            Some((d, a)) => {
+                for (l, o) in out.iter_mut().enumerate().take(prims.len()) {
+                    *o = (d[l], 1.0, a[l], 0.0);
+                }
+            }
+            None => {
+                for (o, p) in out.iter_mut().zip(prims) {
+                    *o = p.value_slope(x, u, scale);
+                }
+            }
+        }
+    }
     fn bounds(&self) -> Aabb {
         Aabb {
             min: self.p,
@@ -139,15 +233,43 @@ pub struct Edge {
     pub val_b: f32,
 }
 
+impl Edge {
+    /// Up to four edges in lanes (unused lanes repeat the last).
+    #[inline]
+    fn lanes(prims: &[Edge]) -> EdgeLanes {
+        let mut e = EdgeLanes::default();
+        for l in 0..4 {
+            let p = &prims[l.min(prims.len() - 1)];
+            for (k, (&a, &b)) in p.a.as_ref().iter().zip(p.b.as_ref()).enumerate() {
+                e.a[k][l] = a as f64;
+                e.b[k][l] = b as f64;
+            }
+            e.val_a[l] = p.val_a as f64;
+            e.val_b[l] = p.val_b as f64;
+        }
+        e
+    }
+}
+
 impl Primitive for Edge {
     const BATCHED: bool = true;
     #[inline]
     fn terms(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [Term; 4]) {
-        super::lanes::edge_terms(prims, x, scale, out)
+        match lanes::edge_terms(&Edge::lanes(prims), x, scale) {
+            Some(t) => fill_terms(&t, out, prims.len()),
+            None => scalar_terms(prims, x, scale, out),
+        }
     }
     #[inline]
     fn values(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [(f64, f64); 4]) {
-        super::lanes::edge_values(prims, x, scale, out)
+        match lanes::edge_values(&Edge::lanes(prims), x, scale) {
+            Some((d, w)) => {
+                for (l, o) in out.iter_mut().enumerate().take(prims.len()) {
+                    *o = (d[l], w[l]);
+                }
+            }
+            None => scalar_values(prims, x, scale, out),
+        }
     }
     /// From the terms, as [`Primitive::value_slope`]'s default does.
     #[inline]
@@ -414,5 +536,130 @@ mod tests {
             varying >= 40,
             "the weights vary at {varying} of 80 points only"
         );
+    }
+
+    // The batches of `primitives::lanes`, bit for bit.
+
+    /// A xorshift generator of values in [-0.5, 0.5).
+    fn rng(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        }
+    }
+
+    /// Scales covering the attenuation's three branches (`q` 1, 0.5 and other).
+    fn scales() -> impl Iterator<Item = WeightScale> {
+        [
+            WeightScale::new(11.0, 100.0, 200.0),
+            WeightScale::new(7.0, 300.0, 200.0),
+            WeightScale::new(40.0, 37.0, 100.0),
+        ]
+        .into_iter()
+        .cycle()
+    }
+
+    /// The batch of `prims` (1 ..= 4) at `x` equals their scalar terms, values and
+    /// slopes along `u` to the last bit.
+    fn assert_same_bits<P: Primitive>(prims: &[P], x: DVec3, u: DVec3, scale: &WeightScale) {
+        let mut terms = [Term::default(); 4];
+        let mut values = [(0.0, 0.0); 4];
+        let mut slopes = [(0.0, 0.0, 0.0, 0.0); 4];
+        P::terms(prims, x, scale, &mut terms);
+        P::values(prims, x, scale, &mut values);
+        P::value_slopes(prims, x, u, scale, &mut slopes);
+        let bits = |t: &Term| {
+            [
+                t.d, t.dir.x, t.dir.y, t.dir.z, t.w, t.grad_w.x, t.grad_w.y, t.grad_w.z,
+            ]
+            .map(f64::to_bits)
+        };
+        for (l, p) in prims.iter().enumerate() {
+            assert_eq!(bits(&terms[l]), bits(&p.term(x, scale)), "term {l} at {x}");
+            let (d, w) = p.value(x, scale);
+            let want = [d, w].map(f64::to_bits);
+            assert_eq!(
+                [values[l].0, values[l].1].map(f64::to_bits),
+                want,
+                "value {l} at {x}"
+            );
+            let (s, t) = (p.value_slope(x, u, scale), slopes[l]);
+            assert_eq!(
+                [t.0, t.1, t.2, t.3].map(f64::to_bits),
+                [s.0, s.1, s.2, s.3].map(f64::to_bits),
+                "value_slope {l} at {x}"
+            );
+        }
+    }
+
+    /// The edges' lanes (`primitives::lanes`) equal their scalar terms to the last bit: empty, short and long
+    /// edges, queries before, past and beside them, valences 1 to 12, every attenuation
+    /// branch, leaves of 1 to 4 edges.
+    #[test]
+    fn edge_lanes_equal_the_scalar_terms_bit_for_bit() {
+        if !lanes::available() {
+            eprintln!("no AVX here: the batch is the scalar path");
+        }
+        let mut r = rng(0x2545_f491_4f6c_dd1d);
+        let (mut ends, mut inside) = (0, 0);
+        for (i, scale) in scales().take(600).enumerate() {
+            let edges: Vec<Edge> = (0..1 + i % 4)
+                .map(|j| {
+                    let mut v = || Vec3::new(r() as f32, r() as f32, r() as f32);
+                    let a = v();
+                    let b = if (i + j) % 9 == 0 { a } else { v() };
+                    let val = |k: usize| (1 + (i * 7 + j * 3 + k) % 12) as f32;
+                    Edge {
+                        a,
+                        b,
+                        val_a: val(0),
+                        val_b: val(1),
+                    }
+                })
+                .collect();
+            for q in 0..8 {
+                let e0 = &edges[0];
+                let x = match q {
+                    0 => e0.a.as_dvec3(),
+                    1 => (0.5 * (e0.a + e0.b)).as_dvec3(),
+                    _ => DVec3::new(r(), r(), r()) * (q as f64),
+                };
+                let u = DVec3::new(r(), r(), r()).normalize();
+                assert_same_bits(&edges, x, u, &scale);
+                for e in &edges {
+                    let (a, b) = (e.a.as_dvec3(), e.b.as_dvec3());
+                    if crate::geometry::closest::closest_on_segment(x, a, b).interior {
+                        inside += 1;
+                    } else {
+                        ends += 1;
+                    }
+                }
+            }
+        }
+        assert!(ends > 500 && inside > 500, "ends {ends}, inside {inside}");
+    }
+
+    /// The points' lanes equal their scalar terms to the last bit, queries on the
+    /// points (zero distance) included.
+    #[test]
+    fn point_lanes_equal_the_scalar_terms_bit_for_bit() {
+        let mut r = rng(0x9e37_79b9_7f4a_7c15);
+        for (i, scale) in scales().take(300).enumerate() {
+            let points: Vec<Point> = (0..1 + i % 4)
+                .map(|_| Point {
+                    p: Vec3::new(r() as f32, r() as f32, r() as f32),
+                })
+                .collect();
+            for q in 0..6 {
+                let x = match q {
+                    0 => points[0].p.as_dvec3(),
+                    _ => DVec3::new(r(), r(), r()) * (q as f64),
+                };
+                let u = DVec3::new(r(), r(), r()).normalize();
+                assert_same_bits(&points, x, u, &scale);
+            }
+        }
     }
 }

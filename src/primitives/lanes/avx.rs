@@ -213,9 +213,8 @@ impl V {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
     #[inline(always)]
-    pub(super) fn lane(self, l: usize) -> DVec3 {
-        let (x, y, z) = (self.x.store(), self.y.store(), self.z.store());
-        DVec3::new(x[l], y[l], z[l])
+    pub(super) fn store(self) -> [[f64; 4]; 3] {
+        [self.x.store(), self.y.store(), self.z.store()]
     }
 }
 

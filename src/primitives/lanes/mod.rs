@@ -1,20 +1,22 @@
-//! A leaf's edges, four at a time: `Edge::term` and `Edge::value` (SPEC 3, 4) computed
-//! in the four lanes of AVX registers (`avx`: the lane types; `edges`: the kernels), with
-//! the same arithmetic in the same order as the scalar code, so every result is the same
-//! to the last bit (the test below compares the bits) and so is every image.
+//! A leaf's edges or points, four at a time: their terms, values and slopes along a ray
+//! (`Primitive::term`, `value`, `value_slope`; SPEC 3, 4) computed in the four lanes of
+//! AVX registers (`avx`: the lane types; `edges`, `points`: the kernels), with the same
+//! arithmetic in the same order as the scalar code, so every result is the same to the
+//! last bit (`primitives::kinds`' tests compare the bits) and so is every image.
 //!
 //! The scalar closest point on a segment (`geometry::closest::closest_on_segment`)
 //! branches on where the query projects (before, past or inside the edge), which near a
-//! soft surface changes from one edge to the next, and each scalar term divides three
-//! times in a row (the two valences' reciprocals, then the projection); here the lanes
-//! compute every case and keep the first that holds, in the scalar code's order, and four
-//! terms share each division. The weight's quartic is the scalar one (`weights::edge_w`,
-//! generic over `weights::Real`). Without AVX (detected once per process), off x86-64, or
-//! with [`SCALAR_ENV`] set, the scalar path does everything. The evaluator calls these
-//! for a leaf's primitives (`eval::sink`, `Primitive::BATCHED`). What they bought, and
-//! why triangles are not among them: doc/performance-log.md, round twenty.
+//! soft surface changes from one edge to the next, and each scalar edge term divides
+//! three times in a row (the two valences' reciprocals, then the projection); here the
+//! lanes compute every case and keep the first that holds, in the scalar code's order,
+//! and four terms share each division (a point's direction likewise). The edge weight's
+//! quartic is the scalar one (`weights::edge_w`, generic over `weights::Real`). Without
+//! AVX (detected once per process), off x86-64, or with [`SCALAR_ENV`] set, the scalar
+//! path does everything (the functions below return `None`). `Edge` and `Point` gather a
+//! leaf into lanes and call these (`Primitive::terms` and its siblings), and the
+//! evaluator asks for a leaf's terms at once (`eval::sink`, `Primitive::BATCHED`). What they bought, and why triangles are not
+//! among them: doc/performance-log.md, round twenty.
 
-use super::kinds::{Edge, Primitive, Term};
 use super::weights::WeightScale;
 use glam::DVec3;
 
@@ -22,6 +24,8 @@ use glam::DVec3;
 mod avx;
 #[cfg(target_arch = "x86_64")]
 mod edges;
+#[cfg(target_arch = "x86_64")]
+mod points;
 
 /// Setting this environment variable (to anything) keeps every term on the scalar
 /// path: for profilers that cannot decode AVX (valgrind 3.19), and for comparisons.
@@ -42,124 +46,87 @@ pub fn available() -> bool {
     }
 }
 
-/// `Primitive::term` of 1 ..= 4 edges into `out[..edges.len()]`.
+/// Four doubles, one per lane.
+pub type Lanes = [f64; 4];
+/// Four 3-vectors, coordinate by coordinate (`[x, y, z]`, each a lane array).
+pub type Lanes3 = [Lanes; 3];
+
+/// Up to four edges: their ends and their ends' valences, lane by lane (unused lanes
+/// repeat a used one).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EdgeLanes {
+    pub a: Lanes3,
+    pub b: Lanes3,
+    pub val_a: Lanes,
+    pub val_b: Lanes,
+}
+
+/// Four terms (`primitives::Term`), lane by lane.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TermLanes {
+    pub d: Lanes,
+    pub dir: Lanes3,
+    pub w: Lanes,
+    pub grad_w: Lanes3,
+}
+
+/// `Edge::term` of four edges, or `None` without AVX.
 #[inline]
-pub fn edge_terms(edges: &[Edge], x: DVec3, scale: &WeightScale, out: &mut [Term; 4]) {
+pub fn edge_terms(e: &EdgeLanes, x: DVec3, scale: &WeightScale) -> Option<TermLanes> {
     #[cfg(target_arch = "x86_64")]
     if available() {
         // SAFETY: AVX was detected.
-        unsafe { edges::terms(edges, x, scale, out) };
-        return;
+        return Some(unsafe { edges::terms(e, x, scale) });
     }
-    for (o, e) in out.iter_mut().zip(edges) {
-        *o = e.term(x, scale);
-    }
+    let _ = (e, x, scale);
+    None
 }
 
-/// `Primitive::value` of 1 ..= 4 edges into `out[..edges.len()]`.
+/// `Edge::value` of four edges (`(d, w)`), or `None` without AVX.
 #[inline]
-pub fn edge_values(edges: &[Edge], x: DVec3, scale: &WeightScale, out: &mut [(f64, f64); 4]) {
+pub fn edge_values(e: &EdgeLanes, x: DVec3, scale: &WeightScale) -> Option<(Lanes, Lanes)> {
     #[cfg(target_arch = "x86_64")]
     if available() {
         // SAFETY: AVX was detected.
-        unsafe { edges::values(edges, x, scale, out) };
-        return;
+        return Some(unsafe { edges::values(e, x, scale) });
     }
-    for (o, e) in out.iter_mut().zip(edges) {
-        *o = e.value(x, scale);
-    }
+    let _ = (e, x, scale);
+    None
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use glam::Vec3;
-
-    /// The edges' lanes equal their scalar terms to the last bit: empty, short and long
-    /// edges, queries before, past and beside them, valences 1 to 12, every attenuation
-    /// branch, leaves of 1 to 4 edges.
-    #[test]
-    fn edge_lanes_equal_the_scalar_terms_bit_for_bit() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut r = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
-        let (mut ends, mut inside) = (0, 0);
-        for (i, scale) in [
-            WeightScale::new(11.0, 100.0, 200.0),
-            WeightScale::new(7.0, 300.0, 200.0),
-            WeightScale::new(40.0, 37.0, 100.0),
-        ]
-        .into_iter()
-        .cycle()
-        .take(600)
-        .enumerate()
-        {
-            let edges: Vec<Edge> = (0..1 + i % 4)
-                .map(|j| {
-                    let mut v = || Vec3::new(r() as f32, r() as f32, r() as f32);
-                    let a = v();
-                    let b = if (i + j) % 9 == 0 { a } else { v() };
-                    let val = |k: usize| (1 + (i * 7 + j * 3 + k) % 12) as f32;
-                    Edge {
-                        a,
-                        b,
-                        val_a: val(0),
-                        val_b: val(1),
-                    }
-                })
-                .collect();
-            for q in 0..8 {
-                let e0 = &edges[0];
-                let x = match q {
-                    0 => e0.a.as_dvec3(),
-                    1 => (0.5 * (e0.a + e0.b)).as_dvec3(),
-                    _ => DVec3::new(r(), r(), r()) * (q as f64),
-                };
-                let u = DVec3::new(r(), r(), r()).normalize();
-                let mut terms = [Term::default(); 4];
-                let mut values = [(0.0, 0.0); 4];
-                let mut slopes = [(0.0, 0.0, 0.0, 0.0); 4];
-                edge_terms(&edges, x, &scale, &mut terms);
-                edge_values(&edges, x, &scale, &mut values);
-                Edge::value_slopes(&edges, x, u, &scale, &mut slopes);
-                for (l, e) in edges.iter().enumerate() {
-                    let (want, got) = (e.term(x, &scale), terms[l]);
-                    let bits = |t: &Term| {
-                        [
-                            t.d, t.dir.x, t.dir.y, t.dir.z, t.w, t.grad_w.x, t.grad_w.y, t.grad_w.z,
-                        ]
-                        .map(f64::to_bits)
-                    };
-                    assert_eq!(bits(&got), bits(&want), "term, edge {i}.{l} at {x}");
-                    let (d, w) = e.value(x, &scale);
-                    assert_eq!(
-                        [values[l].0, values[l].1].map(f64::to_bits),
-                        [d, w].map(f64::to_bits),
-                        "value, edge {i}.{l} at {x}"
-                    );
-                    let s = e.value_slope(x, u, &scale);
-                    assert_eq!(
-                        [slopes[l].0, slopes[l].1, slopes[l].2, slopes[l].3].map(f64::to_bits),
-                        [s.0, s.1, s.2, s.3].map(f64::to_bits),
-                        "value_slope, edge {i}.{l} at {x}"
-                    );
-                    let c = crate::geometry::closest::closest_on_segment(
-                        x,
-                        e.a.as_dvec3(),
-                        e.b.as_dvec3(),
-                    );
-                    if c.interior {
-                        inside += 1;
-                    } else {
-                        ends += 1;
-                    }
-                }
-            }
-        }
-        assert!(ends > 500 && inside > 500, "ends {ends}, inside {inside}");
+/// `Point::term` of four points `p`: distances and directions, or `None` without AVX.
+#[inline]
+pub fn point_terms(p: &Lanes3, x: DVec3) -> Option<(Lanes, Lanes3)> {
+    #[cfg(target_arch = "x86_64")]
+    if available() {
+        // SAFETY: AVX was detected.
+        return Some(unsafe { points::terms(p, x) });
     }
+    let _ = (p, x);
+    None
+}
+
+/// `Point::value` of four points: distances, or `None` without AVX.
+#[inline]
+pub fn point_values(p: &Lanes3, x: DVec3) -> Option<Lanes> {
+    #[cfg(target_arch = "x86_64")]
+    if available() {
+        // SAFETY: AVX was detected.
+        return Some(unsafe { points::values(p, x) });
+    }
+    let _ = (p, x);
+    None
+}
+
+/// `Point::value_slope` of four points: distances and their slopes along `u`, or `None`
+/// without AVX.
+#[inline]
+pub fn point_value_slopes(p: &Lanes3, x: DVec3, u: DVec3) -> Option<(Lanes, Lanes)> {
+    #[cfg(target_arch = "x86_64")]
+    if available() {
+        // SAFETY: AVX was detected.
+        return Some(unsafe { points::value_slopes(p, x, u) });
+    }
+    let _ = (p, x, u);
+    None
 }
