@@ -129,65 +129,8 @@ pub struct Point {
     pub p: Vec3,
 }
 
-impl Point {
-    /// Up to four points' coordinates in lanes (unused lanes repeat the last).
-    #[inline]
-    fn lanes(prims: &[Point]) -> Lanes3 {
-        let mut p = [[0.0; 4]; 3];
-        for l in 0..4 {
-            for (k, &c) in prims[l.min(prims.len() - 1)].p.as_ref().iter().enumerate() {
-                p[k][l] = c as f64;
-            }
-        }
-        p
-    }
-}
-
 impl Primitive for Point {
     const IS_POINT: bool = true;
-    const BATCHED: bool = true;
-    #[inline]
-    fn terms(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [Term; 4]) {
-        match lanes::point_terms(&Point::lanes(prims), x) {
-            Some((d, dir)) => {
-                for (l, o) in out.iter_mut().enumerate().take(prims.len()) {
-                    *o = Term {
-                        d: d[l],
-                        dir: lane3(&dir, l),
-                        w: 1.0,
-                        grad_w: DVec3::ZERO,
-                    };
-                }
-            }
-            None => scalar_terms(prims, x, scale, out),
-        }
-    }
-    #[inline]
-    fn values(prims: &[Self], x: DVec3, scale: &WeightScale, out: &mut [(f64, f64); 4]) {
-        match lanes::point_values(&Point::lanes(prims), x) {
-            Some(d) => {
-                for (l, o) in out.iter_mut().enumerate().take(prims.len()) {
-                    *o = (d[l], 1.0);
-                }
-            }
-            None => scalar_values(prims, x, scale, out),
-        }
-    }
-    #[inline]
-    fn value_slopes(prims: &[Self], x: DVec3, u: DVec3, scale: &WeightScale, out: &mut [Slope; 4]) {
-        match lanes::point_value_slopes(&Point::lanes(prims), x, u) {
-            Some((d, a)) => {
-                for (l, o) in out.iter_mut().enumerate().take(prims.len()) {
-                    *o = (d[l], 1.0, a[l], 0.0);
-                }
-            }
-            None => {
-                for (o, p) in out.iter_mut().zip(prims) {
-                    *o = p.value_slope(x, u, scale);
-                }
-            }
-        }
-    }
     fn bounds(&self) -> Aabb {
         Aabb {
             min: self.p,
@@ -639,27 +582,5 @@ mod tests {
             }
         }
         assert!(ends > 500 && inside > 500, "ends {ends}, inside {inside}");
-    }
-
-    /// The points' lanes equal their scalar terms to the last bit, queries on the
-    /// points (zero distance) included.
-    #[test]
-    fn point_lanes_equal_the_scalar_terms_bit_for_bit() {
-        let mut r = rng(0x9e37_79b9_7f4a_7c15);
-        for (i, scale) in scales().take(300).enumerate() {
-            let points: Vec<Point> = (0..1 + i % 4)
-                .map(|_| Point {
-                    p: Vec3::new(r() as f32, r() as f32, r() as f32),
-                })
-                .collect();
-            for q in 0..6 {
-                let x = match q {
-                    0 => points[0].p.as_dvec3(),
-                    _ => DVec3::new(r(), r(), r()) * (q as f64),
-                };
-                let u = DVec3::new(r(), r(), r()).normalize();
-                assert_same_bits(&points, x, u, &scale);
-            }
-        }
     }
 }

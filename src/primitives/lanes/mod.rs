@@ -1,21 +1,21 @@
-//! A leaf's edges or points, four at a time: their terms, values and slopes along a ray
-//! (`Primitive::term`, `value`, `value_slope`; SPEC 3, 4) computed in the four lanes of
-//! AVX registers (`avx`: the lane types; `edges`, `points`: the kernels), with the same
-//! arithmetic in the same order as the scalar code, so every result is the same to the
-//! last bit (`primitives::kinds`' tests compare the bits) and so is every image.
+//! A leaf's edges, four at a time: their terms and values (`Edge::term`, `Edge::value`;
+//! SPEC 3, 4) computed in the four lanes of AVX registers (`avx`: the lane types;
+//! `edges`: the kernels), with the same arithmetic in the same order as the scalar code,
+//! so every result is the same to the last bit (`primitives::kinds`' tests compare the
+//! bits) and so is every image.
 //!
 //! The scalar closest point on a segment (`geometry::closest::closest_on_segment`)
 //! branches on where the query projects (before, past or inside the edge), which near a
 //! soft surface changes from one edge to the next, and each scalar edge term divides
 //! three times in a row (the two valences' reciprocals, then the projection); here the
 //! lanes compute every case and keep the first that holds, in the scalar code's order,
-//! and four terms share each division (a point's direction likewise). The edge weight's
-//! quartic is the scalar one (`weights::edge_w`, generic over `weights::Real`). Without
-//! AVX (detected once per process), off x86-64, or with [`SCALAR_ENV`] set, the scalar
-//! path does everything (the functions below return `None`). `Edge` and `Point` gather a
-//! leaf into lanes and call these (`Primitive::terms` and its siblings), and the
-//! evaluator asks for a leaf's terms at once (`eval::sink`, `Primitive::BATCHED`). What they bought, and why triangles are not
-//! among them: doc/performance-log.md, round twenty.
+//! and four terms share each division. The weight's quartic is the scalar one
+//! (`weights::edge_w`, generic over `weights::Real`). Without AVX (detected once per
+//! process), off x86-64, or with [`SCALAR_ENV`] set, the scalar path does everything
+//! (the functions below return `None`). `Edge` gathers a leaf into lanes and calls these
+//! (`Primitive::terms`, `values`), and the evaluator asks for a leaf's terms at once
+//! (`eval::sink`, `Primitive::BATCHED`). What they bought, and why triangles and points
+//! are not among them: doc/performance-log.md, round twenty.
 
 use super::weights::WeightScale;
 use glam::DVec3;
@@ -24,8 +24,6 @@ use glam::DVec3;
 mod avx;
 #[cfg(target_arch = "x86_64")]
 mod edges;
-#[cfg(target_arch = "x86_64")]
-mod points;
 
 /// Setting this environment variable (to anything) keeps every term on the scalar
 /// path: for profilers that cannot decode AVX (valgrind 3.19), and for comparisons.
@@ -91,42 +89,5 @@ pub fn edge_values(e: &EdgeLanes, x: DVec3, scale: &WeightScale) -> Option<(Lane
         return Some(unsafe { edges::values(e, x, scale) });
     }
     let _ = (e, x, scale);
-    None
-}
-
-/// `Point::term` of four points `p`: distances and directions, or `None` without AVX.
-#[inline]
-pub fn point_terms(p: &Lanes3, x: DVec3) -> Option<(Lanes, Lanes3)> {
-    #[cfg(target_arch = "x86_64")]
-    if available() {
-        // SAFETY: AVX was detected.
-        return Some(unsafe { points::terms(p, x) });
-    }
-    let _ = (p, x);
-    None
-}
-
-/// `Point::value` of four points: distances, or `None` without AVX.
-#[inline]
-pub fn point_values(p: &Lanes3, x: DVec3) -> Option<Lanes> {
-    #[cfg(target_arch = "x86_64")]
-    if available() {
-        // SAFETY: AVX was detected.
-        return Some(unsafe { points::values(p, x) });
-    }
-    let _ = (p, x);
-    None
-}
-
-/// `Point::value_slope` of four points: distances and their slopes along `u`, or `None`
-/// without AVX.
-#[inline]
-pub fn point_value_slopes(p: &Lanes3, x: DVec3, u: DVec3) -> Option<(Lanes, Lanes)> {
-    #[cfg(target_arch = "x86_64")]
-    if available() {
-        // SAFETY: AVX was detected.
-        return Some(unsafe { points::value_slopes(p, x, u) });
-    }
-    let _ = (p, x, u);
     None
 }
