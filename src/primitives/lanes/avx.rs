@@ -133,32 +133,33 @@ impl F {
         // SAFETY: called only from the AVX kernels.
         F(unsafe { _mm256_xor_pd(self.0, o.0) })
     }
-    /// Lane masks of the comparisons (all bits set where true; NaN compares false,
-    /// except `ne` and `nan`, as in scalar code).
+    /// The lane mask of comparison `OP` (an `_CMP_*` predicate): all bits set where it
+    /// holds.
+    #[inline(always)]
+    fn cmp<const OP: i32>(self, o: F) -> F {
+        // SAFETY: called only from the AVX kernels.
+        F(unsafe { _mm256_cmp_pd::<OP>(self.0, o.0) })
+    }
+    /// Comparisons as in scalar code: NaN compares false, except in `ne` and `nan`.
     #[inline(always)]
     pub(super) fn le(self, o: F) -> F {
-        // SAFETY: called only from the AVX kernels.
-        F(unsafe { _mm256_cmp_pd::<_CMP_LE_OQ>(self.0, o.0) })
+        self.cmp::<_CMP_LE_OQ>(o)
     }
     #[inline(always)]
     pub(super) fn ge(self, o: F) -> F {
-        // SAFETY: called only from the AVX kernels.
-        F(unsafe { _mm256_cmp_pd::<_CMP_GE_OQ>(self.0, o.0) })
+        self.cmp::<_CMP_GE_OQ>(o)
     }
     #[inline(always)]
     pub(super) fn gt(self, o: F) -> F {
-        // SAFETY: called only from the AVX kernels.
-        F(unsafe { _mm256_cmp_pd::<_CMP_GT_OQ>(self.0, o.0) })
+        self.cmp::<_CMP_GT_OQ>(o)
     }
     #[inline(always)]
     pub(super) fn ne(self, o: F) -> F {
-        // SAFETY: called only from the AVX kernels.
-        F(unsafe { _mm256_cmp_pd::<_CMP_NEQ_UQ>(self.0, o.0) })
+        self.cmp::<_CMP_NEQ_UQ>(o)
     }
     #[inline(always)]
     pub(super) fn nan(self) -> F {
-        // SAFETY: called only from the AVX kernels.
-        F(unsafe { _mm256_cmp_pd::<_CMP_UNORD_Q>(self.0, self.0) })
+        self.cmp::<_CMP_UNORD_Q>(self)
     }
     #[inline(always)]
     pub(super) fn and(self, o: F) -> F {
