@@ -602,3 +602,54 @@ fn the_certified_upper_bound_lies_above_the_exact_value() {
         }
     }
 }
+
+/// Soft fields over triangle meshes (`TraceObject::soft_triangles`: triangles alone,
+/// `alpha` times the median edge at most `SOFT_MAX_ALPHA_EDGE`) decide hits at
+/// `hit_beta_scale_soft_triangles` of the scene's beta; edges, points and stiffer fields
+/// keep `hit_beta_scale`. The median edge of a grid of unit squares cut into triangles
+/// (legs 1, diagonals sqrt 2) is 1.
+#[test]
+fn soft_triangle_meshes_are_told_apart_by_alpha_times_the_median_edge() {
+    use smoothtrace::mesh::Mesh;
+    use smoothtrace::primitives::{AnySet, PrimitiveKind};
+    use smoothtrace::render::object::{SOFT_MAX_ALPHA_EDGE, TraceObject};
+    let n = 6;
+    let vertices: Vec<glam::Vec3> = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| glam::Vec3::new(i as f32, j as f32, 0.0)))
+        .collect();
+    let id = |i: u32, j: u32| j * (n + 1) + i;
+    let triangles: Vec<[u32; 3]> = (0..n)
+        .flat_map(|j| {
+            (0..n).flat_map(move |i| {
+                [
+                    [id(i, j), id(i + 1, j), id(i + 1, j + 1)],
+                    [id(i, j), id(i + 1, j + 1), id(i, j + 1)],
+                ]
+            })
+        })
+        .collect();
+    let mesh = Mesh {
+        vertices,
+        segments: Vec::new(),
+        triangles,
+        name: "grid".into(),
+    };
+    let tris = AnySet::build(&mesh, PrimitiveKind::Triangles).unwrap();
+    assert_eq!(tris.median_edge(), Some(1.0));
+    let edges = AnySet::build(&mesh, PrimitiveKind::Edges).unwrap();
+    assert_eq!(edges.median_edge(), Some(1.0));
+    assert_eq!(
+        AnySet::build(&mesh, PrimitiveKind::Points)
+            .unwrap()
+            .median_edge(),
+        None
+    );
+    let object = |set: &AnySet, alpha: f64| {
+        TraceObject::new(vec![set.clone()], EvalParams::new(alpha, alpha, 0.5))
+    };
+    assert!(object(&tris, SOFT_MAX_ALPHA_EDGE).soft_triangles());
+    assert!(!object(&tris, SOFT_MAX_ALPHA_EDGE * 1.01).soft_triangles());
+    assert!(!object(&edges, 1.0).soft_triangles());
+    let both = TraceObject::new(vec![tris.clone(), edges], EvalParams::new(1.0, 1.0, 0.5));
+    assert!(!both.soft_triangles());
+}

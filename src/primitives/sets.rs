@@ -176,6 +176,32 @@ impl AnySet {
         self.len() == 0
     }
 
+    /// The median length of the edges of its primitives (each triangle's three, so an
+    /// inner edge counts twice); `None` for points or an empty set.
+    pub fn median_edge(&self) -> Option<f64> {
+        let mut lengths: Vec<f32> = match self {
+            AnySet::Points(_) => return None,
+            AnySet::Edges(s) => s.prims.iter().map(|e| (e.b - e.a).length()).collect(),
+            AnySet::Triangles(s) => s
+                .prims
+                .iter()
+                .flat_map(|t| {
+                    [
+                        (t.b - t.a).length(),
+                        (t.c - t.b).length(),
+                        (t.a - t.c).length(),
+                    ]
+                })
+                .collect(),
+        };
+        if lengths.is_empty() {
+            return None;
+        }
+        let mid = lengths.len() / 2;
+        let (_, m, _) = lengths.select_nth_unstable_by(mid, f32::total_cmp);
+        Some(*m as f64)
+    }
+
     pub fn max_adj(&self) -> f64 {
         with_set!(self, s => s.max_adj)
     }

@@ -8,6 +8,12 @@ use crate::mesh::Aabb;
 use crate::primitives::{AnySet, WeightScale};
 use glam::DVec3;
 
+/// The largest `alpha` times median edge length at which an object of triangles counts
+/// as soft (`TraceObject::soft_triangles`): there the tracer decides hits at a coarser
+/// beta (`TracerOptions::hit_beta_scale_soft_triangles`; doc/performance-log.md, round
+/// twenty-one).
+pub const SOFT_MAX_ALPHA_EDGE: f64 = 3.0;
+
 /// Primitive sets summed into one smooth distance, evaluated with `params`.
 pub struct TraceObject {
     pub sets: Vec<AnySet>,
@@ -36,6 +42,19 @@ impl TraceObject {
 
     pub fn set_refs(&self) -> Vec<&AnySet> {
         self.sets.iter().collect()
+    }
+
+    /// Whether the object is made of triangles alone and its `alpha` times their median
+    /// edge length is at most [`SOFT_MAX_ALPHA_EDGE`]: a soft field over a dense mesh,
+    /// where many triangles lie within the kernel's width.
+    pub fn soft_triangles(&self) -> bool {
+        self.signed.is_none()
+            && !self.sets.is_empty()
+            && self.sets.iter().all(|s| {
+                matches!(s, AnySet::Triangles(_))
+                    && s.median_edge()
+                        .is_some_and(|e| self.params.alpha * e <= SOFT_MAX_ALPHA_EDGE)
+            })
     }
 
     /// How far outside the data's bounding box the zero set can reach at sharpness

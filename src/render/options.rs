@@ -29,6 +29,10 @@ pub struct TracerOptions {
     /// Hits on objects with edges or triangles are decided at this share of the scene's
     /// beta (tracer module docs, item 9); 1 decides them at the scene's beta (the paper's).
     pub hit_beta_scale: f64,
+    /// The same for soft fields over triangle meshes (`TraceObject::soft_triangles`):
+    /// many triangles within the kernel's width, where a coarser beta keeps the hits as
+    /// close to the exact surface (doc/performance-log.md, round twenty-one).
+    pub hit_beta_scale_soft_triangles: f64,
     /// Full evaluations that only take a step (not predicted to hit) are made at this
     /// opening parameter when it is coarser than the scene's (0 = the scene's beta):
     /// still a lower bound, so the step is safe, at a fraction of the terms. Any value in
@@ -85,6 +89,7 @@ impl TracerOptions {
             neighbours: true,
             relax: true,
             hit_beta_scale: 0.6,
+            hit_beta_scale_soft_triangles: 0.7,
             step_beta: 1.0,
             learn_step_beta: true,
             reach_steps: true,
@@ -106,6 +111,7 @@ impl TracerOptions {
             neighbours: false,
             relax: false,
             hit_beta_scale: 1.0,
+            hit_beta_scale_soft_triangles: 1.0,
             step_beta: 0.0,
             learn_step_beta: false,
             reach_steps: false,

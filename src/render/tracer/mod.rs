@@ -66,7 +66,11 @@
 //!    returns to the plain step; a sample's free distance ahead, when longer, is the
 //!    step. Same surface, fewer steps at grazing incidence.
 //! 9. Hits are decided at a finer beta (`TracerOptions::hit_beta_scale` times the
-//!    scene's, 0.6 by default): the Barnes-Hut sum is a lower bound of the exact one,
+//!    scene's, 0.6 by default; 0.7, `hit_beta_scale_soft_triangles`, for soft fields
+//!    over triangle meshes, `TraceObject::soft_triangles`: there the far-field nodes that
+//!    make the difference are a few triangles each, and 0.7 keeps the hits within the
+//!    accuracy goals with a fifth fewer leaves, doc/performance-log.md, round
+//!    twenty-one): the Barnes-Hut sum is a lower bound of the exact one,
 //!    but where `alpha` times the size of far-field nodes is large (soft point clouds,
 //!    dense edge meshes at small `alpha`) it can be many epsilons low, and a ray that
 //!    stops where it drops below epsilon stops short of the exact surface. Evaluations
@@ -267,7 +271,13 @@ impl<'a> Tracer<'a> {
             .iter()
             .zip(&points_only)
             .map(|(o, &points)| {
-                let scale = if points { 1.0 } else { options.hit_beta_scale };
+                let scale = if points {
+                    1.0
+                } else if o.soft_triangles() {
+                    options.hit_beta_scale_soft_triangles
+                } else {
+                    options.hit_beta_scale
+                };
                 o.params.beta * scale.clamp(0.0, 1.0)
             })
             .collect();
