@@ -67,9 +67,8 @@
 //!    step. Same surface, fewer steps at grazing incidence.
 //! 9. Hits are decided at a finer beta (`TracerOptions::hit_beta_scale` times the
 //!    scene's, 0.6 by default; 0.7, `hit_beta_scale_soft_triangles`, for soft fields
-//!    over triangle meshes, `TraceObject::soft_triangles`: there the far-field nodes that
-//!    make the difference are a few triangles each, and 0.7 keeps the hits within the
-//!    accuracy goals with a fifth fewer leaves, doc/performance-log.md, round
+//!    over triangle meshes, `TraceObject::soft_triangles`, where it keeps the hits
+//!    within the accuracy goals with a fifth fewer leaves: doc/performance-log.md, round
 //!    twenty-one): the Barnes-Hut sum is a lower bound of the exact one,
 //!    but where `alpha` times the size of far-field nodes is large (soft point clouds,
 //!    dense edge meshes at small `alpha`) it can be many epsilons low, and a ray that
