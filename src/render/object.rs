@@ -26,17 +26,30 @@ pub struct TraceObject {
     /// `surface = "signed"`: the object draws this offset surface of its triangles'
     /// signed distance instead of its smooth distance's zero set (`render::signed`).
     pub signed: Option<SignedSurface>,
+    /// The largest median edge length of its sets when all are triangles (`None`
+    /// otherwise), measured once: what [`TraceObject::soft_triangles`] compares with
+    /// `alpha` (the scene builder's server changes `alpha`, not the sets).
+    triangle_edge: Option<f64>,
 }
 
 impl TraceObject {
     pub fn new(sets: Vec<AnySet>, params: EvalParams) -> TraceObject {
         let bounds = sets.iter().fold(Aabb::EMPTY, |b, s| b.union(s.bounds()));
+        let triangle_edge = sets
+            .iter()
+            .map(|s| match s {
+                AnySet::Triangles(_) => s.median_edge(),
+                _ => None,
+            })
+            .try_fold(0.0f64, |longest, e| e.map(|e| longest.max(e)))
+            .filter(|_| !sets.is_empty());
         TraceObject {
             sets,
             params,
             bounds,
             colours: None,
             signed: None,
+            triangle_edge,
         }
     }
 
@@ -49,12 +62,9 @@ impl TraceObject {
     /// where many triangles lie within the kernel's width.
     pub fn soft_triangles(&self) -> bool {
         self.signed.is_none()
-            && !self.sets.is_empty()
-            && self.sets.iter().all(|s| {
-                matches!(s, AnySet::Triangles(_))
-                    && s.median_edge()
-                        .is_some_and(|e| self.params.alpha * e <= SOFT_MAX_ALPHA_EDGE)
-            })
+            && self
+                .triangle_edge
+                .is_some_and(|e| self.params.alpha * e <= SOFT_MAX_ALPHA_EDGE)
     }
 
     /// How far outside the data's bounding box the zero set can reach at sharpness
