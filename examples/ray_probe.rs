@@ -387,6 +387,7 @@ fn main() {
                         None,
                         false,
                         false,
+                        smoothtrace::eval::FarShare::OFF,
                     );
                     let st = e.stats;
                     sum[0] += st.exact as f64;

@@ -165,6 +165,85 @@ fn barnes_hut_never_exceeds_exact_and_is_conservative() {
 }
 
 #[test]
+fn far_terms_by_share_stay_conservative_and_spare_terms_on_soft_fields() {
+    // A dense sphere (2,300 triangles) at soft and stiff alphas: far terms by share keep
+    // the value below the exact one for any level (even one below the value, which
+    // loosens the rule), its gradient finite, and the rule off gives the walk as before.
+    use smoothtrace::eval::FarShare;
+    let sphere = bumpy_sphere(34, 36);
+    let mut rng = Rng::new(31);
+    let qs = queries(&sphere, &mut rng, 120);
+    let diag = sphere.bounds().diagonal();
+    for k in [PrimitiveKind::Edges, PrimitiveKind::Triangles] {
+        let set = AnySet::build(&sphere, k).unwrap();
+        for ad in [30.0, 100.0, 1000.0] {
+            let alpha = ad / diag;
+            let (mut exact_off, mut exact_on) = (0u64, 0u64);
+            for &x in &qs {
+                let (s_exact, _, _) = brute::smooth_distance(&[&set], x, alpha, alpha);
+                let rounding = 1e-12 * s_scale(s_exact, alpha);
+                for beta in [0.0, 0.3] {
+                    let off = EvalParams {
+                        prune_tolerance: 2.5e-3,
+                        ..EvalParams::new(alpha, alpha, beta)
+                    };
+                    let base = eval::evaluate(&[&set], x, &off);
+                    let same = eval::evaluate(
+                        &[&set],
+                        x,
+                        &EvalParams {
+                            far_share: FarShare::OFF,
+                            ..off
+                        },
+                    );
+                    assert_eq!(base.s.to_bits(), same.s.to_bits(), "off changes the walk");
+                    for (share, level) in [
+                        (4e-4, f64::INFINITY),
+                        (4e-4, s_exact.max(0.0)),
+                        (4e-3, s_exact - 10.0 / alpha),
+                        (0.2, -1.0),
+                    ] {
+                        let p = EvalParams {
+                            far_share: FarShare { share, level },
+                            ..off
+                        };
+                        let got = eval::evaluate(&[&set], x, &p);
+                        assert!(
+                            got.s <= s_exact + rounding,
+                            "{k} alpha*diag {ad} beta {beta} share {share} level {level}: {} above the exact {s_exact} at {x}",
+                            got.s
+                        );
+                        assert!(got.grad.is_finite(), "gradient {:?}", got.grad);
+                        if share == 4e-4 && level.is_finite() && beta == 0.3 {
+                            exact_on += got.stats.exact as u64;
+                            exact_off += base.stats.exact as u64;
+                            // A share of 4e-4 per term, with a level at the value: the
+                            // value within a few hundredths of a kernel width.
+                            assert!(
+                                got.s >= base.s - 0.05 / alpha,
+                                "{k} alpha*diag {ad}: {} far below {} without the rule",
+                                got.s,
+                                base.s
+                            );
+                        }
+                    }
+                }
+            }
+            assert!(
+                exact_on <= exact_off,
+                "{k} alpha*diag {ad}: {exact_on} exact terms with the rule, {exact_off} without"
+            );
+            if ad <= 100.0 {
+                assert!(
+                    exact_on * 10 <= exact_off * 9,
+                    "{k} alpha*diag {ad}: {exact_on} exact terms with the rule, {exact_off} without"
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn pruning_off_gives_the_same_values() {
     let sphere = bumpy_sphere(10, 16);
     let set = AnySet::build(&sphere, PrimitiveKind::Triangles).unwrap();

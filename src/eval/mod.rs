@@ -22,5 +22,5 @@ pub mod walk;
 
 pub use accumulate::Accumulation;
 pub use nearest::{Nearest, nearest};
-pub use params::{EvalParams, EvalStats};
+pub use params::{EvalParams, EvalStats, FarShare};
 pub use smooth::{Along, Sample, evaluate, evaluate_along, evaluate_reach, evaluate_value};

@@ -32,6 +32,29 @@ pub(super) fn rule_tolerances(p: &EvalParams) -> (f64, f64) {
     }
 }
 
+/// Far-field terms by their share of the sum (`eval::smooth` module docs): a subtree that
+/// beta would open is also taken as one far-field term when its bound `n w exp(-alpha r)`
+/// is at most `share` times the larger of the sum so far and `exp(-alpha level)`, the
+/// sum where `s` equals `level` (an estimate from above of the value being computed: the
+/// sum so far is small early in the walk). The term bounds its subtree from above, so
+/// `s` stays a lower bound of the exact value; the share only decides how much work the
+/// evaluation spends on accuracy.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FarShare {
+    /// At most this share of the sum per term, in `[0, 1)`; 0 turns the rule off.
+    pub share: f64,
+    /// The value `s` is expected not to exceed (`+inf`: unknown, the sum so far alone).
+    pub level: f64,
+}
+
+impl FarShare {
+    /// The rule off (the default): far fields by beta alone.
+    pub const OFF: FarShare = FarShare {
+        share: 0.0,
+        level: f64::INFINITY,
+    };
+}
+
 /// Parameters of one smooth-distance evaluation.
 #[derive(Clone, Copy, Debug)]
 pub struct EvalParams {
@@ -57,6 +80,9 @@ pub struct EvalParams {
     /// Prune against a budget as well (module docs; default on, only with `prune` and
     /// the stable sum): the same tolerance, far fewer leaves.
     pub budget: bool,
+    /// Far-field terms by their share of the sum as well as by beta ([`FarShare`];
+    /// default off).
+    pub far_share: FarShare,
 }
 
 impl EvalParams {
@@ -71,6 +97,7 @@ impl EvalParams {
             moments: true,
             upper_bound: false,
             budget: true,
+            far_share: FarShare::OFF,
         }
     }
 

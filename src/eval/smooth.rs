@@ -34,6 +34,15 @@
 //!   `n w_ff exp(-alpha r)` with direction `(x - c) / r` and `w_ff = max_adj^q`. Every
 //!   primitive below is at least `r` away with weight at most `w_ff`, so the far term
 //!   dominates the terms it replaces and the approximate `s` never exceeds the exact one.
+//! - far field by share (`EvalParams::far_share`, off by default; the tracer's hit
+//!   decisions on soft meshes): a subtree that beta would open and the budget did not
+//!   prune is one far-field term as well when its bound `n w_ff exp(-alpha r)` is at
+//!   most `share` times the larger of the shifted sum so far and the floor `exp(-alpha
+//!   level)`, the sum where `s` equals a given `level` (tested with the budget's stepped
+//!   logarithms, `eval::walk`). The term dominates the terms it replaces, as every far
+//!   term does, so `s` stays a lower bound; what the share decides is how much work goes
+//!   into accuracy (each such term lowers `s` by at most `share / alpha` when the
+//!   value is not above `level`).
 //! - otherwise descend; leaves add their primitives' exact terms.
 //!
 //! Far field of point clouds from second moments (`EvalParams::moments`, default on):

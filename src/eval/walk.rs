@@ -99,6 +99,12 @@ pub(super) struct Walk<'w, 'a, P, const GRAD: bool, const SLOPE: bool> {
     alpha_log2e: f64,
     /// `floor(log2 w_ff) + 1`: `2^e_w` bounds the weight of one primitive.
     e_w: i64,
+    /// `log2` of the far-field share (`EvalParams::far_share`; `-inf` when off).
+    share_log2: f64,
+    /// `level - log2(share) ln 2 / alpha`: a subtree of bound weight `nw` is a far term
+    /// by share against the floor `exp(-alpha level)` beyond
+    /// `log2(nw) ln 2 / alpha + share_reach` (`+inf` when off or without a level).
+    share_reach: f64,
 }
 
 /// `floor(log2 v)` for a positive normal `v`.
@@ -209,6 +215,16 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             ln2_over_alpha: std::f64::consts::LN_2 / p.alpha,
             alpha_log2e: p.alpha * std::f64::consts::LOG2_E,
             e_w: exponent(scale.max_weight()) + 1,
+            share_log2: if p.far_share.share > 0.0 {
+                p.far_share.share.log2()
+            } else {
+                f64::NEG_INFINITY
+            },
+            share_reach: if p.far_share.share > 0.0 {
+                p.far_share.level - p.far_share.share.log2() * std::f64::consts::LN_2 / p.alpha
+            } else {
+                f64::INFINITY
+            },
         }
     }
 
@@ -270,6 +286,30 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         acc.pruned += charge;
         self.stats.pruned += 1;
         true
+    }
+
+    /// A subtree of `n` primitives at squared distance `r2 > 0` whose bound `b = n w
+    /// exp(-alpha r)` is at most the share of the larger of the sum so far and the
+    /// level's floor (`EvalParams::far_share`), tested with bounds of the logarithms
+    /// (as `budget_prune`): against the floor, `alpha r >= ln(n w) + alpha level - ln
+    /// share`; against the shifted sum `S`, `alpha (r - m) >= ln(n w) - ln(share S)`.
+    #[inline(always)]
+    fn small_share(&self, r2: f64, n: u32) -> bool {
+        if self.share_log2 == f64::NEG_INFINITY || r2 <= 0.0 {
+            return false;
+        }
+        let l = log2_up(n as f64 * self.w_ff);
+        let floor = l * self.ln2_over_alpha + self.share_reach;
+        if floor <= 0.0 || r2 >= floor * floor {
+            return true;
+        }
+        let acc = &self.sink.acc;
+        let sum = acc.shifted_sum();
+        if sum <= 0.0 || !sum.is_normal() {
+            return false;
+        }
+        let need = acc.m + (l - log2_down(sum) - self.share_log2) * self.ln2_over_alpha;
+        need <= 0.0 || r2 >= need * need
     }
 
     #[inline(always)]
@@ -377,6 +417,10 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         if r2m >= budget2 && self.budget_prune(r2m, node.mid_size[j]) {
             return;
         }
+        if node.mid_diam2[j].is_finite() && self.small_share(r2m, node.mid_size[j]) {
+            self.far_middle(node, i, j, (near, r2m));
+            return;
+        }
         for k in [2 * j, 2 * j + 1] {
             self.slot(node, i, k, d2[k], (reach2, budget2), open);
         }
@@ -460,6 +504,10 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
             return;
         }
         if d2k >= budget2 && self.budget_prune(d2k, node.size[k]) {
+            return;
+        }
+        if self.small_share(d2k, node.size[k]) {
+            self.far_slot(node, i, k, d2k);
             return;
         }
         open.insert(d2k, k);

@@ -9,10 +9,20 @@ use super::tracer::{FieldSample, Hit, RayStats, Tracer, Want};
 use glam::DVec3;
 
 impl Tracer<'_> {
-    /// A value at the hit beta while locating a crossing, counted as a backtrack.
+    /// A value at the hit beta while locating a crossing, counted as a backtrack (its far
+    /// terms by share against the sum alone: no level is known inside the bracket).
     fn backtrack_sample(&self, x: DVec3, stats: &mut RayStats) -> FieldSample {
         let before = stats.evals;
-        let f = self.sample(x, stats, Want::Value, true, None, StepBeta::default());
+        let level = f64::INFINITY;
+        let f = self.sample(
+            x,
+            stats,
+            Want::Value,
+            true,
+            level,
+            None,
+            StepBeta::default(),
+        );
         stats.backtracks += stats.evals - before;
         f
     }

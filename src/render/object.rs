@@ -3,7 +3,7 @@
 
 use super::signed::SignedSurface;
 use crate::colour::ObjectColours;
-use crate::eval::{self, Along, EvalParams, Sample};
+use crate::eval::{self, Along, EvalParams, FarShare, Sample};
 use crate::mesh::Aabb;
 use crate::primitives::{AnySet, WeightScale};
 use glam::DVec3;
@@ -110,7 +110,8 @@ impl TraceObject {
     /// decisions a finer one) and the pruning tolerance possibly raised (a lower bound
     /// too, see `eval::smooth`), with the gradient if `grad`, and with the free distances
     /// along a ray if `along` is given (`eval::reach`); with closest-box
-    /// far fields if `bound` (a bound step); with `Sample::s_upper` if `upper`.
+    /// far fields if `bound` (a bound step); with `Sample::s_upper` if `upper`; with far
+    /// terms by share as well as by beta where `far_share` says so (hit decisions).
     #[allow(clippy::too_many_arguments)]
     pub fn evaluate(
         &self,
@@ -123,6 +124,7 @@ impl TraceObject {
         along: Option<Along>,
         bound: bool,
         upper: bool,
+        far_share: FarShare,
     ) -> Sample {
         if let Some(signed) = &self.signed {
             return signed.sample(x, grad);
@@ -136,6 +138,7 @@ impl TraceObject {
         // either keeps a bound step safe, and the tighter moment terms buy no longer steps
         // there for their extra cost (performance log, round four).
         p.moments &= !bound;
+        p.far_share = far_share;
         eval::evaluate_along(sets, x, along, &p, grad)
     }
 }

@@ -2,6 +2,12 @@
 //! parameters. Each field's meaning is stated where it is declared; the items cited are
 //! those of the `render::tracer` module docs.
 
+/// The default [`TracerOptions::far_share`]: a far term by share lowers `s` by at most
+/// `share / alpha`; at 4e-4 the hits on the soft full bunny sit 0.07 epsilons farther
+/// from the exact surface at the median, for a fifth fewer leaves per hit ray
+/// (doc/performance-log.md, round twenty-two).
+pub const FAR_SHARE: f64 = 4e-4;
+
 /// Tracer settings.
 #[derive(Clone, Copy, Debug)]
 pub struct TracerOptions {
@@ -33,6 +39,10 @@ pub struct TracerOptions {
     /// many triangles within the kernel's width, where a coarser beta keeps the hits as
     /// close to the exact surface (doc/performance-log.md, round twenty-one).
     pub hit_beta_scale_soft_triangles: f64,
+    /// Evaluations at the hit beta on edges and triangles also take a subtree as one
+    /// far-field term when its bound is at most this share of the sum
+    /// (`eval::FarShare`, tracer module docs item 9; 0 = off, the paper's).
+    pub far_share: f64,
     /// Full evaluations that only take a step (not predicted to hit) are made at this
     /// opening parameter when it is coarser than the scene's (0 = the scene's beta):
     /// still a lower bound, so the step is safe, at a fraction of the terms. Any value in
@@ -90,6 +100,7 @@ impl TracerOptions {
             relax: true,
             hit_beta_scale: 0.6,
             hit_beta_scale_soft_triangles: 0.7,
+            far_share: FAR_SHARE,
             step_beta: 1.0,
             learn_step_beta: true,
             reach_steps: true,
@@ -112,6 +123,7 @@ impl TracerOptions {
             relax: false,
             hit_beta_scale: 1.0,
             hit_beta_scale_soft_triangles: 1.0,
+            far_share: 0.0,
             step_beta: 0.0,
             learn_step_beta: false,
             reach_steps: false,

@@ -80,6 +80,18 @@
 //!    Objects made of points alone keep the scene's beta for hits: their far-field
 //!    terms come from second moments (`eval::smooth`), within 0.07% of the diagonal of
 //!    the exact surface even on the deer at alpha 1 (1% with the closest-box terms).
+//!    On edges and triangles whose hit band is narrow against the kernel (`alpha
+//!    epsilon < 0.4`, where the pruning tolerance of item 6 is below its cap and a sum
+//!    holds many terms), evaluations at the hit beta also take a subtree as one
+//!    far-field term when its closest-box bound is at most `TracerOptions::far_share`
+//!    (4e-4) of the sum (`eval::FarShare`): of the sum so far, or of the sum at the
+//!    ray's last full value, which the new one is expected not to exceed (early in a
+//!    walk the sum so far is small). Beta opens a subtree by its size against its
+//!    distance; the share leaves it closed when its terms cannot weigh much. Still a
+//!    lower bound: on the softest cells of the speed matrix a quarter fewer leaves per
+//!    ray, the hits 0.07 epsilons farther from the exact surface at the median on the
+//!    soft full bunny (doc/performance-log.md, round twenty-two). Off with certified
+//!    hits (item 11), whose halvings must reach the exact sum.
 //! 10. On point clouds, full evaluations that only take a step (not predicted to hit)
 //!     are made at the coarser `TracerOptions::step_beta` (1 by default): a lower bound
 //!     too, so the step is safe, at 60-75% of the terms near the surface; a value in
@@ -230,6 +242,8 @@ pub struct Tracer<'a> {
     hit_beta: Vec<f64>,
     /// Opening parameter per object of the full evaluations that only take a step.
     step_beta: Vec<f64>,
+    /// Share per object of the far terms by share at the hit beta (0: off; item 9).
+    far_share: Vec<f64>,
     /// Some object decides hits at a finer beta than its steps.
     refine: bool,
     /// Some object decides hits at a finer beta than the scene's (edges, triangles): from
@@ -256,7 +270,7 @@ impl<'a> Tracer<'a> {
             min = min.min(o.bounds.min.as_dvec3() - r);
             max = max.max(o.bounds.max.as_dvec3() + r);
         }
-        let tolerance = objects
+        let tolerance: Vec<f64> = objects
             .iter()
             .map(|o| (PRUNE_SHARE * o.params.alpha * options.epsilon).min(MAX_PRUNE_TOLERANCE))
             .collect();
@@ -293,6 +307,22 @@ impl<'a> Tracer<'a> {
                 }
             })
             .collect();
+        // Far terms by share on edges and triangles where the hit band is narrow against
+        // the kernel (the pruning tolerance below its cap, `alpha epsilon < 0.4`): there
+        // a sum has many terms. Where it is capped, pruning already takes shares of 1%
+        // (item 9; doc/performance-log.md, round twenty-two). Not with certified hits,
+        // whose halvings of the hit beta must reach the exact sum (item 11).
+        let far_share = points_only
+            .iter()
+            .zip(&tolerance)
+            .map(|(&points, &tol)| {
+                if points || tol >= MAX_PRUNE_TOLERANCE || options.certified_hits {
+                    0.0
+                } else {
+                    options.far_share
+                }
+            })
+            .collect();
         let refine = step_beta.iter().zip(&hit_beta).any(|(s, h)| s != h);
         let tau = options.epsilon
             * if points_only.iter().all(|&p| p) {
@@ -311,6 +341,7 @@ impl<'a> Tracer<'a> {
             tolerance,
             hit_beta,
             step_beta,
+            far_share,
             refine,
             sticky,
             tau,
@@ -417,6 +448,9 @@ impl<'a> Tracer<'a> {
         let mut want = Want::Value;
         // Once set, every full evaluation of the ray is accurate (module docs, item 9).
         let mut accurate = false;
+        // The ray's last full value: the next is expected below it (module docs, item
+        // 9: the floor of the far terms by share).
+        let mut level = f64::INFINITY;
         // The tile's step beta (`render::step_beta`): at the hit beta, no refinement.
         let step_beta = steps.as_deref().copied().unwrap_or_default();
         let refine = self.refine && !step_beta.at_hit_beta();
@@ -432,6 +466,7 @@ impl<'a> Tracer<'a> {
                     &mut stats,
                     Want::Bound(beta),
                     false,
+                    f64::INFINITY,
                     None,
                     StepBeta::default(),
                 );
@@ -484,7 +519,7 @@ impl<'a> Tracer<'a> {
                     0.0
                 },
             });
-            let mut f = self.sample(x, &mut stats, want, fine, along, step_beta);
+            let mut f = self.sample(x, &mut stats, want, fine, level, along, step_beta);
             // Whether `f` is at the hit beta. On edges and triangles (`sticky`) a slope is
             // only measured between values of one beta: the scene's is lower there by a
             // share that changes along the ray, and a slope across the switch (0.2 where
@@ -508,7 +543,7 @@ impl<'a> Tracer<'a> {
                 accurate = true;
                 stats.refinements += 1;
                 let coarse = f.s;
-                f = self.sample(x, &mut stats, Want::Gradient, true, along, step_beta);
+                f = self.sample(x, &mut stats, Want::Gradient, true, level, along, step_beta);
                 f_fine = true;
                 if let Some(st) = steps.as_deref_mut() {
                     st.refined(coarse, f.s, eps);
@@ -526,7 +561,7 @@ impl<'a> Tracer<'a> {
                 accurate = true;
                 stats.hit_halvings += 1;
                 stats.refinements += 1;
-                f = self.sample(x, &mut stats, Want::Gradient, true, along, step_beta);
+                f = self.sample(x, &mut stats, Want::Gradient, true, level, along, step_beta);
             }
             near = f.s - gap < 2.0 * tau;
             if f.s.abs() <= eps {
@@ -583,6 +618,7 @@ impl<'a> Tracer<'a> {
                 Want::Value
             };
             prev = Some((t, f.s, f.reach));
+            level = f.s;
             t += step;
         }
         RayResult { hit: None, stats }
@@ -600,7 +636,8 @@ impl<'a> Tracer<'a> {
     ) -> Hit {
         let grad = match f.grad {
             Some(g) => g,
-            None => self.gradient(f.object, o + t * d, stats),
+            // At a hit the value is within epsilon.
+            None => self.gradient(f.object, o + t * d, self.options.epsilon, stats),
         };
         // Where the field falls along the ray (`k > 0`): one more step, free, from a
         // positive value (the sample's ball, or its free distance along the ray, is

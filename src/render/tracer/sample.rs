@@ -9,7 +9,7 @@
 //! (`eval::reach`), which steps and neighbours' free cones use.
 
 use super::{RayStats, Tracer};
-use crate::eval::Along;
+use crate::eval::{Along, FarShare};
 use crate::render::step_beta::StepBeta;
 use glam::DVec3;
 
@@ -46,7 +46,15 @@ pub(in crate::render) enum Want {
 impl<'a> Tracer<'a> {
     /// The scene field at `x` (the minimum over objects) and the object attaining it.
     pub fn field(&self, x: DVec3, stats: &mut RayStats) -> (f64, usize) {
-        let f = self.sample(x, stats, Want::Value, false, None, StepBeta::default());
+        let f = self.sample(
+            x,
+            stats,
+            Want::Value,
+            false,
+            f64::INFINITY,
+            None,
+            StepBeta::default(),
+        );
         (f.s, f.object)
     }
 
@@ -59,6 +67,7 @@ impl<'a> Tracer<'a> {
             stats,
             Want::Bound(beta),
             false,
+            f64::INFINITY,
             None,
             StepBeta::default(),
         )
@@ -75,9 +84,23 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    /// Object `k`'s far terms by share (`TracerOptions::far_share`, module docs item 9)
+    /// in an evaluation at the hit beta whose value is expected not to exceed `level`.
+    fn far_share(&self, k: usize, level: f64) -> FarShare {
+        if self.far_share[k] > 0.0 {
+            FarShare {
+                share: self.far_share[k],
+                level,
+            }
+        } else {
+            FarShare::OFF
+        }
+    }
+
     /// The gradient of object `k`'s smooth distance at `x` (one evaluation, at the hit
-    /// beta).
-    pub fn gradient(&self, k: usize, x: DVec3, stats: &mut RayStats) -> DVec3 {
+    /// beta; its far terms by share against the floor of `level`, which the value there is
+    /// expected not to exceed).
+    pub fn gradient(&self, k: usize, x: DVec3, level: f64, stats: &mut RayStats) -> DVec3 {
         let obj = &self.objects[k];
         let mut alpha = obj.params.alpha;
         loop {
@@ -91,6 +114,7 @@ impl<'a> Tracer<'a> {
                 None,
                 false,
                 false,
+                self.far_share(k, level),
             );
             stats.evals += 1;
             stats.eval.add(&sample.stats);
@@ -103,12 +127,18 @@ impl<'a> Tracer<'a> {
     }
 
     /// The scene field at `x` for `want`; full evaluations at the hit beta if `accurate`.
+    /// Full evaluations at a beta finer than the scene's (the hit beta, or a tile's
+    /// steps there) take far terms by share too, against the floor of `level`, which
+    /// the value is expected not to exceed (the ray's last full value; `+inf` when
+    /// unknown).
+    #[allow(clippy::too_many_arguments)]
     pub(in crate::render) fn sample(
         &self,
         x: DVec3,
         stats: &mut RayStats,
         want: Want,
         accurate: bool,
+        level: f64,
         along: Option<Along>,
         step_beta: StepBeta,
     ) -> FieldSample {
@@ -148,6 +178,11 @@ impl<'a> Tracer<'a> {
                     along,
                     coarse.is_some(),
                     self.options.certified_hits && coarse.is_none(),
+                    if coarse.is_none() && beta < obj.params.beta {
+                        self.far_share(k, level)
+                    } else {
+                        FarShare::OFF
+                    },
                 );
                 if coarse.is_some() {
                     stats.coarse_evals += 1;
