@@ -208,8 +208,13 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
                 w_ff: sc.max_weight(),
                 upper: p.upper_bound,
             };
+            let share = p.far_share.share > 0.0;
             crate::with_set!(set, s => {
-                Walk::new(s, x, p, &sc, prune_margin, budget, &mut sink, &mut stats, stack).run()
+                if share {
+                    Walk::<_, GRAD, SLOPE, true>::new(s, x, p, &sc, prune_margin, budget, &mut sink, &mut stats, stack).run()
+                } else {
+                    Walk::<_, GRAD, SLOPE, false>::new(s, x, p, &sc, prune_margin, budget, &mut sink, &mut stats, stack).run()
+                }
             });
         }
     });

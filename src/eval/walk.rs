@@ -77,7 +77,9 @@ impl Open {
 const SIGNIFICANT: f64 = 2.0;
 
 /// One walk over one set at `x`: its decisions go to the sink and the statistics.
-pub(super) struct Walk<'w, 'a, P, const GRAD: bool, const SLOPE: bool> {
+/// `SHARE`: far terms by share are asked for (`EvalParams::far_share`); a walk without
+/// them carries no test of it.
+pub(super) struct Walk<'w, 'a, P, const GRAD: bool, const SLOPE: bool, const SHARE: bool> {
     set: &'w PrimitiveSet<P>,
     x: DVec3,
     scale: &'w WeightScale,
@@ -186,7 +188,9 @@ fn pow2(e: i64) -> f64 {
     }
 }
 
-impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, GRAD, SLOPE> {
+impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: bool>
+    Walk<'w, 'a, P, GRAD, SLOPE, SHARE>
+{
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         set: &'w PrimitiveSet<P>,
@@ -288,6 +292,12 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         true
     }
 
+    /// Far terms by share are asked for.
+    #[inline(always)]
+    fn share_on(&self) -> bool {
+        SHARE && self.share_log2 > f64::NEG_INFINITY
+    }
+
     /// A subtree of `n` primitives at squared distance `r2 > 0` whose bound `b = n w
     /// exp(-alpha r)` is at most the share of the larger of the sum so far and the
     /// level's floor (`EvalParams::far_share`), tested with bounds of the logarithms
@@ -295,7 +305,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
     /// share`; against the shifted sum `S`, `alpha (r - m) >= ln(n w) - ln(share S)`.
     #[inline(always)]
     fn small_share(&self, r2: f64, n: u32) -> bool {
-        if self.share_log2 == f64::NEG_INFINITY || r2 <= 0.0 {
+        if r2 <= 0.0 {
             return false;
         }
         let l = log2_up(n as f64 * self.w_ff);
@@ -417,7 +427,10 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         if r2m >= budget2 && self.budget_prune(r2m, node.mid_size[j]) {
             return;
         }
-        if node.mid_diam2[j].is_finite() && self.small_share(r2m, node.mid_size[j]) {
+        if self.share_on()
+            && node.mid_diam2[j].is_finite()
+            && self.small_share(r2m, node.mid_size[j])
+        {
             self.far_middle(node, i, j, (near, r2m));
             return;
         }
@@ -506,7 +519,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool> Walk<'w, 'a, P, 
         if d2k >= budget2 && self.budget_prune(d2k, node.size[k]) {
             return;
         }
-        if self.small_share(d2k, node.size[k]) {
+        if self.share_on() && self.small_share(d2k, node.size[k]) {
             self.far_slot(node, i, k, d2k);
             return;
         }
