@@ -166,9 +166,10 @@ fn barnes_hut_never_exceeds_exact_and_is_conservative() {
 
 #[test]
 fn far_terms_by_share_stay_conservative_and_spare_terms_on_soft_fields() {
-    // A dense sphere (2,300 triangles) at soft and stiff alphas: far terms by share keep
+    // A dense sphere (2,376 triangles) at soft and stiff alphas: far terms by share keep
     // the value below the exact one for any level (even one below the value, which
-    // loosens the rule), its gradient finite, and the rule off gives the walk as before.
+    // loosens the rule) and its gradient finite; with a level at the value they cost
+    // little accuracy and spare exact terms where the field is soft.
     use smoothtrace::eval::FarShare;
     let sphere = bumpy_sphere(34, 36);
     let mut rng = Rng::new(31);
@@ -188,15 +189,6 @@ fn far_terms_by_share_stay_conservative_and_spare_terms_on_soft_fields() {
                         ..EvalParams::new(alpha, alpha, beta)
                     };
                     let base = eval::evaluate(&[&set], x, &off);
-                    let same = eval::evaluate(
-                        &[&set],
-                        x,
-                        &EvalParams {
-                            far_share: FarShare::OFF,
-                            ..off
-                        },
-                    );
-                    assert_eq!(base.s.to_bits(), same.s.to_bits(), "off changes the walk");
                     for (share, level) in [
                         (4e-4, f64::INFINITY),
                         (4e-4, s_exact.max(0.0)),
