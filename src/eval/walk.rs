@@ -101,11 +101,11 @@ pub(super) struct Walk<'w, 'a, P, const GRAD: bool, const SLOPE: bool, const SHA
     alpha_log2e: f64,
     /// `floor(log2 w_ff) + 1`: `2^e_w` bounds the weight of one primitive.
     e_w: i64,
-    /// `log2` of the far-field share (`EvalParams::far_share`; `-inf` when off).
+    /// `log2` of the far-field share (`EvalParams::far_share`; read only when `SHARE`).
     share_log2: f64,
     /// `level - log2(share) ln 2 / alpha`: a subtree of bound weight `nw` is a far term
     /// by share against the floor `exp(-alpha level)` beyond
-    /// `log2(nw) ln 2 / alpha + share_reach` (`+inf` when off or without a level).
+    /// `log2(nw) ln 2 / alpha + share_reach` (`+inf` without a level).
     share_reach: f64,
 }
 
@@ -203,6 +203,8 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
         stats: &'w mut EvalStats,
         stack: &'w mut Vec<Entry>,
     ) -> Self {
+        // Read only by walks with `SHARE`, which run where the share is positive.
+        let share_log2 = p.far_share.share.log2();
         Walk {
             set,
             x,
@@ -219,16 +221,8 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
             ln2_over_alpha: std::f64::consts::LN_2 / p.alpha,
             alpha_log2e: p.alpha * std::f64::consts::LOG2_E,
             e_w: exponent(scale.max_weight()) + 1,
-            share_log2: if p.far_share.share > 0.0 {
-                p.far_share.share.log2()
-            } else {
-                f64::NEG_INFINITY
-            },
-            share_reach: if p.far_share.share > 0.0 {
-                p.far_share.level - p.far_share.share.log2() * std::f64::consts::LN_2 / p.alpha
-            } else {
-                f64::INFINITY
-            },
+            share_log2,
+            share_reach: p.far_share.level - share_log2 * std::f64::consts::LN_2 / p.alpha,
         }
     }
 
@@ -290,12 +284,6 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
         acc.pruned += charge;
         self.stats.pruned += 1;
         true
-    }
-
-    /// Far terms by share are asked for.
-    #[inline(always)]
-    fn share_on(&self) -> bool {
-        SHARE && self.share_log2 > f64::NEG_INFINITY
     }
 
     /// A subtree of `n` primitives at squared distance `r2 > 0` whose bound `b = n w
@@ -427,10 +415,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
         if r2m >= budget2 && self.budget_prune(r2m, node.mid_size[j]) {
             return;
         }
-        if self.share_on()
-            && node.mid_diam2[j].is_finite()
-            && self.small_share(r2m, node.mid_size[j])
-        {
+        if SHARE && node.mid_diam2[j].is_finite() && self.small_share(r2m, node.mid_size[j]) {
             self.far_middle(node, i, j, (near, r2m));
             return;
         }
@@ -519,7 +504,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
         if d2k >= budget2 && self.budget_prune(d2k, node.size[k]) {
             return;
         }
-        if self.share_on() && self.small_share(d2k, node.size[k]) {
+        if SHARE && self.small_share(d2k, node.size[k]) {
             self.far_slot(node, i, k, d2k);
             return;
         }
