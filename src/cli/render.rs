@@ -289,6 +289,7 @@ pub fn run(a: RenderArgs) -> Result<()> {
     // Every output is checked before the render (issue 10, defect 5).
     let outputs = check_outputs(&a, &film)?;
     film.keep_aovs = !outputs.aovs.is_empty();
+    film.hit_gap = true;
     let (coarse_beta, certified_hits) = (a.coarse_beta, a.certified_hits);
     let tracer_options = |o: TracerOptions| TracerOptions {
         coarse_beta,
@@ -415,6 +416,14 @@ pub fn run(a: RenderArgs) -> Result<()> {
             "warning: {} rays ran out of steps (max_steps = {}) and were drawn as misses",
             exhausted,
             scene.render.max_steps
+        );
+    }
+    if let Some(gap) = stats.iter().filter_map(|s| s.hit_gap).find(|g| g.loose()) {
+        note!(
+            "note: at the hits the exact smooth distance may lie up to {:.0} epsilons above the value they were decided on (median {:.1}, certified bounds at {} hits): the far field is loose where the kernel is wide against the mesh's detail, and the surface is drawn outside the exact one. --certified-hits decides hits within one epsilon of the exact sum (slower)",
+            gap.max,
+            gap.median,
+            gap.samples
         );
     }
     let falloffs: u64 = stats.iter().map(|s| s.falloffs).sum();

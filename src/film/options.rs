@@ -51,6 +51,9 @@ pub struct FilmOptions {
     pub crop: Option<Rect>,
     /// Keep the per-pixel records the AOVs need (normal, object, position, cost).
     pub keep_aovs: bool,
+    /// Report how far the exact smooth distance may lie above the hits' values
+    /// (`render::hit_gap`, in the image's statistics): a few more evaluations.
+    pub hit_gap: bool,
 }
 
 impl Default for FilmOptions {
@@ -63,6 +66,7 @@ impl Default for FilmOptions {
             transparent: false,
             crop: None,
             keep_aovs: false,
+            hit_gap: false,
         }
     }
 }

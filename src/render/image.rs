@@ -16,6 +16,7 @@
 //!   still gives its AOV record.
 
 use super::cone::{ConeStats, Tile, trace_tile};
+use super::hit_gap::{self, HitGap};
 use super::tracer::{Hit, RayResult, RayStats, Tracer};
 use crate::camera::Camera;
 use crate::film::accumulate::PixelAccum;
@@ -23,7 +24,7 @@ use crate::film::aov::{AovBuffers, PixelRecord};
 use crate::film::pattern::{Sample, pattern, primary};
 use crate::film::{AaMode, FilmOptions, Rect};
 use crate::matcap::MatCap;
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use image::{GrayImage, RgbImage};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -97,6 +98,9 @@ pub struct ImageStats {
     /// Wall-clock seconds of the tracing loop.
     pub seconds: f64,
     pub threads: usize,
+    /// How far the exact smooth distance may lie above the value at a sample of the hits
+    /// (`render::hit_gap`), when asked for (`FilmOptions::hit_gap`) and not certified.
+    pub hit_gap: Option<HitGap>,
 }
 
 impl ImageStats {
@@ -386,6 +390,9 @@ pub fn render_film(
     }
     progress(region.height() as u64);
     stats.seconds = start.elapsed().as_secs_f64();
+    if options.hit_gap && !tracer.options().certified_hits {
+        stats.hit_gap = hit_gap::measure(tracer, &film.hit_points());
+    }
     Some(film.develop(options, stats))
 }
 
@@ -639,6 +646,15 @@ impl RegionFilm {
             self.accum[i] = accum;
             self.records[i] = record;
         }
+    }
+
+    /// The hit points of the pixels' primary samples, row by row.
+    fn hit_points(&self) -> Vec<DVec3> {
+        self.records
+            .iter()
+            .filter(|r| r.is_hit())
+            .map(|r| Vec3::from(r.position).as_dvec3())
+            .collect()
     }
 
     /// Replaces a pixel's colour samples, adding the new rays' cost.

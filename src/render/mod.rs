@@ -2,6 +2,7 @@
 
 mod backtrack;
 pub mod cone;
+pub mod hit_gap;
 pub mod neighbours;
 pub mod object;
 pub mod options;

@@ -315,6 +315,7 @@ impl Scene {
             transparent: self.image.transparent,
             crop: None,
             keep_aovs: false,
+            hit_gap: false,
         }
     }
 

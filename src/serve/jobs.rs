@@ -202,6 +202,7 @@ impl Jobs {
                 transparent: false,
                 crop: None,
                 keep_aovs: !matches!(view.aov, Aov::Shaded | Aov::Depth),
+                hit_gap: false,
             };
             let rendered =
                 render_film(&tracer, &camera, &built.shaders, &film, &|_| {}, &cancelled);

@@ -126,6 +126,37 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    /// The scene field at `x` as a hit decides it (each object at its hit beta, pruning
+    /// tolerance and far terms by share, the level at epsilon as for a hit's gradient),
+    /// with a certified upper bound of the exact field (`eval::smooth`, `s_upper`): the
+    /// exact smooth distance lies in `[lower, upper]`. Objects made of points, whose far
+    /// terms come from moments that the upper bound does not cover, give `upper = +inf`.
+    pub fn value_interval(&self, x: DVec3) -> (f64, f64) {
+        let (mut lower, mut upper) = (f64::INFINITY, f64::INFINITY);
+        for (k, obj) in self.objects.iter().enumerate() {
+            let sample = obj.evaluate(
+                &self.sets[k],
+                x,
+                obj.params.alpha,
+                self.hit_beta[k],
+                self.tolerance[k],
+                false,
+                None,
+                false,
+                true,
+                self.far_share(k, self.options.epsilon),
+            );
+            let covered = self.weighted[k] || obj.signed.is_some();
+            lower = lower.min(sample.s);
+            upper = upper.min(if covered {
+                sample.s_upper
+            } else {
+                f64::INFINITY
+            });
+        }
+        (lower, upper)
+    }
+
     /// The scene field at `x` for `want`; full evaluations at the hit beta if `accurate`.
     /// Full evaluations at a beta finer than the scene's (the hit beta, or a tile's
     /// steps there) take far terms by share too, against the floor of `level`, which
