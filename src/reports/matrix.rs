@@ -17,9 +17,10 @@ use super::table::{Cell, Table};
 use super::{Progress, render_objects};
 use crate::mesh::Mesh;
 use crate::primitives::PrimitiveKind;
-use crate::render::TracerOptions;
 use crate::render::build::{BuildError, build_scene};
+use crate::render::hit_gap::{self, HitGap};
 use crate::render::image::ImageStats;
+use crate::render::{Tracer, TracerOptions};
 use crate::scene::{Scene, SceneError};
 use std::path::PathBuf;
 
@@ -121,6 +122,9 @@ pub struct Measured {
     pub alpha_edge: Option<f64>,
     pub stats: ImageStats,
     pub error: Option<DepthDiff>,
+    /// How far the exact value may lie above the hits' (`render::hit_gap`; `None` with
+    /// certified hits, for point clouds and without hits).
+    pub gap: Option<HitGap>,
 }
 
 /// One row of the report: measured, or skipped with the reason (a missing mesh file).
@@ -307,6 +311,22 @@ fn run_cell(
             rendered = r;
         }
     }
+    // One sample per pixel: each hit lies on its pixel-centre ray at the recorded depth.
+    let gap = (!opts.certified_hits).then(|| {
+        let tracer = Tracer::new(
+            &built.objects,
+            TracerOptions::new(built.epsilon, scene.render.max_steps),
+        );
+        let w = built.camera.width() as usize;
+        let hits: Vec<glam::DVec3> = (rendered.depth.iter().enumerate())
+            .filter(|(_, t)| t.is_finite())
+            .map(|(i, &t)| {
+                let (o, d) = built.camera.ray((i % w) as u32, (i / w) as u32);
+                o + f64::from(t) * d
+            })
+            .collect();
+        hit_gap::measure(&tracer, &hits)
+    });
     let error = match opts.error_size {
         None => None,
         Some(es) => {
@@ -328,6 +348,7 @@ fn run_cell(
         alpha_edge: None,
         stats: rendered.stats,
         error,
+        gap: gap.flatten(),
     })
 }
 
@@ -353,6 +374,8 @@ pub fn table(rows: &[MatrixRow]) -> Table {
         ("error_p50", "err p50"),
         ("error_p99", "err p99"),
         ("error_only_one_percent", "1-sided %"),
+        ("gap_p50", "gap p50"),
+        ("gap_max", "gap max"),
         ("skipped", "skipped"),
     ]);
     for r in rows {
@@ -386,11 +409,13 @@ pub fn table(rows: &[MatrixRow]) -> Table {
                         e.map(|e| 100.0 * e.only_one as f64 / e.rays.max(1) as f64),
                         3,
                     ),
+                    Cell::num(m.gap.map(|g| g.median), 2),
+                    Cell::num(m.gap.map(|g| g.max), 2),
                     Cell::Empty,
                 ]);
             }
             Err(reason) => {
-                row.extend((0..15).map(|_| Cell::Empty));
+                row.extend((0..17).map(|_| Cell::Empty));
                 row.push(Cell::text(reason));
             }
         }
