@@ -567,7 +567,8 @@ fn certified_hits_put_a_soft_dense_mesh_on_its_exact_surface() {
 
 /// The evaluation's upper bound (`EvalParams::upper_bound`: far-field subtrees at their
 /// lower bounds, pruned ones at zero) lies above the exact smooth distance, as the value
-/// lies below it, on triangles and edges at every beta and pruning tolerance.
+/// lies below it, on triangles, edges and points (whose far terms then come from the
+/// closest box, not from moments) at every beta and pruning tolerance.
 #[test]
 fn the_certified_upper_bound_lies_above_the_exact_value() {
     let mesh = common::bumpy_sphere(24, 48);
@@ -575,6 +576,7 @@ fn the_certified_upper_bound_lies_above_the_exact_value() {
     for kind in [
         smoothtrace::primitives::PrimitiveKind::Triangles,
         smoothtrace::primitives::PrimitiveKind::Edges,
+        smoothtrace::primitives::PrimitiveKind::Points,
     ] {
         let set = smoothtrace::primitives::AnySet::build(&mesh, kind).unwrap();
         for alpha in [3.0, 30.0, 300.0] {

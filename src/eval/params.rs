@@ -75,7 +75,9 @@ pub struct EvalParams {
     /// default on). Off, every far-field term is the closest-box one (the paper's).
     pub moments: bool,
     /// Also bound the exact value from above (`Sample::s_upper`; far-field subtrees at
-    /// their lower bounds): one more exponential per far-field term. Default off.
+    /// their lower bounds): one more exponential per far-field term, and point clouds'
+    /// far fields from the closest box instead of moments (a moment term has no lower
+    /// bound beside it). Default off.
     pub upper_bound: bool,
     /// Prune against a budget as well (module docs; default on, only with `prune` and
     /// the stable sum): the same tolerance, far fewer leaves.

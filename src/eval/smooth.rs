@@ -100,9 +100,9 @@ pub struct Sample {
     pub reach_back: f64,
     pub stats: EvalStats,
     /// With `EvalParams::upper_bound`, an upper bound of the exact smooth distance
-    /// (far-field terms at the lower bound of their subtrees, pruned ones at zero; the
-    /// second-moment terms of point clouds count as exact, so there it is an estimate);
-    /// `+inf` otherwise.
+    /// (far-field terms at the lower bound of their subtrees, pruned ones at zero; point
+    /// clouds' far terms then come from the closest box, not from second moments, which
+    /// have no lower bound beside them); `+inf` otherwise.
     pub s_upper: f64,
 }
 

@@ -216,7 +216,13 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
             inv_alpha: 1.0 / p.alpha,
             beta2: if p.beta > 0.0 { p.beta * p.beta } else { -1.0 },
             w_ff: scale.max_weight(),
-            moments: if p.moments { &set.bvh.moments } else { &[] },
+            // A moment term has no lower bound beside it: an upper bound of the value
+            // takes closest-box far fields (`EvalParams::upper_bound`).
+            moments: if p.moments && !p.upper_bound {
+                &set.bvh.moments
+            } else {
+                &[]
+            },
             budget,
             ln2_over_alpha: std::f64::consts::LN_2 / p.alpha,
             alpha_log2e: p.alpha * std::f64::consts::LOG2_E,

@@ -129,10 +129,14 @@ impl<'a> Tracer<'a> {
     /// The scene field at `x` as a hit decides it (each object at its hit beta, pruning
     /// tolerance and far terms by share, the level at epsilon as for a hit's gradient),
     /// with a certified upper bound of the exact field (`eval::smooth`, `s_upper`): the
-    /// exact smooth distance lies in `[lower, upper]`. Objects made of points, whose far
-    /// terms come from moments that the upper bound does not cover, give `upper = +inf`.
+    /// exact smooth distance lies in `[lower, upper]`. Point clouds decide hits on far
+    /// terms from moments, and an upper bound takes closest-box ones (`eval::smooth`),
+    /// whose interval is much wider than the value's error: where an object made of
+    /// points attains `lower`, `upper` is `+inf` (another object's upper bound would hold,
+    /// but would say how far that object is, not how loose the value is).
     pub fn value_interval(&self, x: DVec3) -> (f64, f64) {
         let (mut lower, mut upper) = (f64::INFINITY, f64::INFINITY);
+        let mut lowest_covered = true;
         for (k, obj) in self.objects.iter().enumerate() {
             let sample = obj.evaluate(
                 &self.sets[k],
@@ -147,14 +151,15 @@ impl<'a> Tracer<'a> {
                 self.far_share(k, self.options.epsilon),
             );
             let covered = self.weighted[k] || obj.signed.is_some();
-            lower = lower.min(sample.s);
-            upper = upper.min(if covered {
-                sample.s_upper
-            } else {
-                f64::INFINITY
-            });
+            if sample.s < lower {
+                lower = sample.s;
+                lowest_covered = covered;
+            }
+            if covered {
+                upper = upper.min(sample.s_upper);
+            }
         }
-        (lower, upper)
+        (lower, if lowest_covered { upper } else { f64::INFINITY })
     }
 
     /// The scene field at `x` for `want`; full evaluations at the hit beta if `accurate`.
