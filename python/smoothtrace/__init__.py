@@ -241,6 +241,17 @@ class SmoothDistance:
         """The smooth distance at each row of ``P`` ((n, 3)): an (n,) float64 array."""
         return self._native.value(_coordinates(P, "P"), _threads(threads))
 
+    def value_bounds(
+        self, P: Any, threads: Optional[int] = None
+    ) -> Tuple[np.ndarray, np.ndarray]:
+        """The smooth distance at each row of ``P`` with a certified interval around the
+        exact (beta 0) value: ``(lower, upper)``, two (n,) float64 arrays with ``lower <=
+        exact <= upper``. ``lower`` is the Barnes-Hut sum (as ``value`` gives it, but for
+        point clouds, whose far terms here bound from the closest box, not from moments);
+        ``upper`` takes every far-field subtree at its lower bound. Their difference says
+        how much ``beta`` costs in accuracy at each point."""
+        return self._native.value_bounds(_coordinates(P, "P"), _threads(threads))
+
     def value_and_gradient(
         self, P: Any, threads: Optional[int] = None
     ) -> Tuple[np.ndarray, np.ndarray]:

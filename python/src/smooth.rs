@@ -94,6 +94,26 @@ impl SmoothDistance {
         })
     }
 
+    /// The smooth distance at each row of `points` with a certified upper bound of the
+    /// exact value: `(lower, upper)`.
+    #[pyo3(signature = (points, threads=None))]
+    fn value_bounds<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyReadonlyArray2<'py, f64>,
+        threads: Option<i64>,
+    ) -> PyResult<(Arr1<'py>, Arr1<'py>)> {
+        guard(|| {
+            let p = crate::arrays::points(&points, "points")?;
+            let t = self::threads(threads)?;
+            let (lo, hi) = py
+                .detach(|| with_threads(t, || queries::value_bounds(&self.object, &p)))
+                .map_err(to_py)?;
+            let n = lo.len();
+            Ok((output::<_, Ix1>(py, n, lo)?, output::<_, Ix1>(py, n, hi)?))
+        })
+    }
+
     /// The smooth distance and its gradient at each row of `points`.
     #[pyo3(signature = (points, threads=None))]
     fn value_and_gradient<'py>(

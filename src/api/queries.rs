@@ -111,6 +111,23 @@ pub fn values(object: &TraceObject, points: &[DVec3]) -> Vec<f64> {
     in_morton_order(points, |x| eval::evaluate_value(&sets, x, &object.params).s)
 }
 
+/// The smooth distance at every point with a certified interval around the exact value:
+/// `(lower, upper)`, `lower` the value of [`values`] (the Barnes-Hut sum is a lower bound)
+/// and `upper` from the same walk with every far-field subtree at its lower bound (its
+/// farthest corner, weight 1; pruned ones at zero: `eval::smooth`, `s_upper`). Point
+/// clouds' far terms are then the closest box's rather than their moments, so `lower`
+/// may be below [`values`]' there.
+pub fn value_bounds(object: &TraceObject, points: &[DVec3]) -> (Vec<f64>, Vec<f64>) {
+    let sets = object.set_refs();
+    let mut p = object.params;
+    p.upper_bound = true;
+    let both = in_morton_order(points, |x| {
+        let r = eval::evaluate_value(&sets, x, &p);
+        (r.s, r.s_upper)
+    });
+    both.into_iter().unzip()
+}
+
 /// The smooth distance and its gradient at every point; gradients as a flat `(n, 3)`
 /// array.
 pub fn values_and_gradients(object: &TraceObject, points: &[DVec3]) -> (Vec<f64>, Vec<f64>) {
@@ -220,6 +237,64 @@ mod tests {
             let d = (dx * dx + x.z * x.z).sqrt();
             assert!((n[i].d - d).abs() < 1e-6, "{} vs {d}", n[i].d);
             assert!((n[i].point - x).length() - n[i].d < 1e-9);
+        }
+    }
+
+    /// `value_bounds` brackets the exact (brute-force) value on triangles, edges and
+    /// points at soft and stiff alphas and several betas, its lower end is `values`' on
+    /// meshes, and the interval closes as beta goes to 0.
+    #[test]
+    fn value_bounds_bracket_the_exact_value() {
+        let mut rnd = uniform(11);
+        let mesh = soup(120, 0.2, &mut rnd);
+        let pts: Vec<DVec3> = (0..150)
+            .map(|_| DVec3::new(rnd(), rnd(), rnd()) * 1.4 - 0.2)
+            .collect();
+        for kind in [
+            PrimitiveKind::Triangles,
+            PrimitiveKind::Edges,
+            PrimitiveKind::Points,
+        ] {
+            for alpha_rel in [10.0, 100.0, 1000.0] {
+                let mut widths = Vec::new();
+                for beta in [0.0, 0.5, 1.0] {
+                    let spec = ObjectSpec {
+                        kinds: vec![kind],
+                        alpha: None,
+                        alpha_rel: Some(alpha_rel),
+                        max_alpha: None,
+                        max_alpha_rel: None,
+                        beta,
+                        tolerance: None,
+                    };
+                    let obj = build_object(&mesh, &spec, Naming::Keyword).unwrap();
+                    let (lo, hi) = value_bounds(&obj, &pts);
+                    let v = values(&obj, &pts);
+                    let sets = obj.set_refs();
+                    let mut width: f64 = 0.0;
+                    for (i, &x) in pts.iter().enumerate() {
+                        let exact = brute::smooth_distance(
+                            &sets,
+                            x,
+                            obj.params.alpha,
+                            obj.params.max_alpha,
+                        )
+                        .0;
+                        let slack = 1e-9 * exact.abs().max(1e-3);
+                        let at = format!("{kind:?} alpha_rel {alpha_rel} beta {beta} at {x}");
+                        assert!(lo[i] <= exact + slack, "{at}: lower {} > {exact}", lo[i]);
+                        assert!(hi[i] >= exact - slack, "{at}: upper {} < {exact}", hi[i]);
+                        if kind != PrimitiveKind::Points {
+                            assert_eq!(lo[i], v[i], "{at}");
+                        }
+                        width = width.max(hi[i] - lo[i]);
+                    }
+                    widths.push(width * obj.params.alpha);
+                }
+                // Exact at beta 0 up to the pruning (a share 1e-10 of the sum).
+                assert!(widths[0] < 1e-8, "{kind:?} {alpha_rel}: {widths:?}");
+                assert!(widths[2] >= widths[1], "{kind:?} {alpha_rel}: {widths:?}");
+            }
         }
     }
 

@@ -151,3 +151,23 @@ def test_several_sets_are_summed(torus_mesh, rng):
     m = np.minimum(s1, s2)
     ref = m - np.log(np.exp(-15.0 * (s1 - m)) + np.exp(-15.0 * (s2 - m))) / 15.0
     np.testing.assert_allclose(both.value(P), ref, rtol=1e-9, atol=1e-10)
+
+
+@pytest.mark.parametrize("kind", ["points", "edges", "triangles"])
+def test_value_bounds_bracket_the_exact_value(torus_mesh, rng, kind):
+    V, F = torus_mesh
+    P = queries(V, 200, rng, 0.1)
+    for alpha_rel in (20.0, 200.0):
+        exact = st.SmoothDistance(V, faces=F, primitives=kind, alpha_rel=alpha_rel, beta=0.0)
+        approx = st.SmoothDistance(V, faces=F, primitives=kind, alpha_rel=alpha_rel, beta=0.7)
+        s0 = exact.value(P)
+        lo, hi = approx.value_bounds(P)
+        assert lo.shape == hi.shape == (len(P),) and lo.dtype == hi.dtype == np.float64
+        slack = 1e-9 / approx.alpha + 1e-9 * np.abs(s0)
+        assert (lo <= s0 + slack).all() and (s0 <= hi + slack).all()
+        assert (hi - lo).max() > 1e-6 / approx.alpha  # beta 0.7 is not exact somewhere
+        if kind != "points":
+            np.testing.assert_array_equal(lo, approx.value(P))
+        # At beta 0 the interval closes (up to the pruning, a share 1e-10 of the sum).
+        lo0, hi0 = exact.value_bounds(P)
+        assert ((hi0 - lo0) * exact.alpha < 1e-8).all()
