@@ -175,6 +175,19 @@ mod tests {
             .unwrap()
     }
 
+    /// One primitive kind at `alpha_rel` and `beta`, the default tolerance.
+    fn spec_rel(kind: PrimitiveKind, alpha_rel: f64, beta: f64) -> ObjectSpec {
+        ObjectSpec {
+            kinds: vec![kind],
+            alpha: None,
+            alpha_rel: Some(alpha_rel),
+            max_alpha: None,
+            max_alpha_rel: None,
+            beta,
+            tolerance: None,
+        }
+    }
+
     /// A stream of uniform numbers in [0, 1) from `seed` (a linear congruential generator).
     fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
         move || {
@@ -201,15 +214,7 @@ mod tests {
     #[test]
     fn batch_values_match_single_queries_and_brute_force() {
         let mesh = square();
-        let spec = ObjectSpec {
-            kinds: vec![PrimitiveKind::Triangles],
-            alpha: None,
-            alpha_rel: Some(20.0),
-            max_alpha: None,
-            max_alpha_rel: None,
-            beta: 0.0,
-            tolerance: None,
-        };
+        let spec = spec_rel(PrimitiveKind::Triangles, 20.0, 0.0);
         let obj = build_object(&mesh, &spec, Naming::Keyword).unwrap();
         assert_eq!(obj.params.alpha, 20.0 / 2f64.sqrt());
         let pts: Vec<DVec3> = (0..50)
@@ -258,15 +263,7 @@ mod tests {
             for alpha_rel in [10.0, 100.0, 1000.0] {
                 let mut widths = Vec::new();
                 for beta in [0.0, 0.5, 1.0] {
-                    let spec = ObjectSpec {
-                        kinds: vec![kind],
-                        alpha: None,
-                        alpha_rel: Some(alpha_rel),
-                        max_alpha: None,
-                        max_alpha_rel: None,
-                        beta,
-                        tolerance: None,
-                    };
+                    let spec = spec_rel(kind, alpha_rel, beta);
                     let obj = build_object(&mesh, &spec, Naming::Keyword).unwrap();
                     let (lo, hi) = value_bounds(&obj, &pts);
                     let v = values(&obj, &pts);

@@ -51,7 +51,7 @@ impl HitGap {
 /// [`MIN_STRIDE`] or fewer, taken evenly; `None` without hits, or where no object's upper bound covers them (point
 /// clouds, whose far terms come from moments).
 pub fn measure(tracer: &Tracer, hits: &[DVec3]) -> Option<HitGap> {
-    if hits.is_empty() {
+    if hits.is_empty() || !tracer.covers_gaps() {
         return None;
     }
     let stride = hits.len().div_ceil(MAX_SAMPLES).max(MIN_STRIDE);

@@ -126,6 +126,18 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    /// Whether object `k`'s hits can be given an interval by [`Tracer::value_interval`]
+    /// (not made of points alone).
+    fn gap_covered(&self, k: usize) -> bool {
+        self.weighted[k] || self.objects[k].signed.is_some()
+    }
+
+    /// Whether some object's hits can be given an interval ([`Tracer::value_interval`]
+    /// gives `upper = +inf` everywhere otherwise).
+    pub fn covers_gaps(&self) -> bool {
+        (0..self.objects.len()).any(|k| self.gap_covered(k))
+    }
+
     /// The scene field at `x` as a hit decides it (each object at its hit beta, pruning
     /// tolerance and far terms by share, the level at epsilon as for a hit's gradient),
     /// with a certified upper bound of the exact field (`eval::smooth`, `s_upper`): the
@@ -150,7 +162,7 @@ impl<'a> Tracer<'a> {
                 true,
                 self.far_share(k, self.options.epsilon),
             );
-            let covered = self.weighted[k] || obj.signed.is_some();
+            let covered = self.gap_covered(k);
             if sample.s < lower {
                 lower = sample.s;
                 lowest_covered = covered;
