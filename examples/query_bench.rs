@@ -73,15 +73,7 @@ fn main() {
     let beta: f64 = arg("--beta", 0.5);
     let repeat: usize = arg("--repeat", 3);
     let mesh = Mesh::load(mesh_path.as_ref()).expect("mesh");
-    let spec = ObjectSpec {
-        kinds: vec![PrimitiveKind::Triangles],
-        alpha: None,
-        alpha_rel: Some(alpha_rel),
-        max_alpha: None,
-        max_alpha_rel: None,
-        beta,
-        tolerance: None,
-    };
+    let spec = ObjectSpec::relative(vec![PrimitiveKind::Triangles], alpha_rel, beta);
     let mut object = queries::build_object(&mesh, &spec, Naming::Keyword).expect("object");
     // `--tol`: the share of the sum pruning may skip (`EvalParams::prune_tolerance`).
     object.params.prune_tolerance = arg("--tol", object.params.prune_tolerance);

@@ -29,6 +29,22 @@ pub struct ObjectSpec {
     pub tolerance: Option<f64>,
 }
 
+impl ObjectSpec {
+    /// `kinds` at `alpha_rel` (alpha times the diagonal) and `beta`; max_alpha and the
+    /// tolerance at their defaults.
+    pub fn relative(kinds: Vec<PrimitiveKind>, alpha_rel: f64, beta: f64) -> ObjectSpec {
+        ObjectSpec {
+            kinds,
+            alpha: None,
+            alpha_rel: Some(alpha_rel),
+            max_alpha: None,
+            max_alpha_rel: None,
+            beta,
+            tolerance: None,
+        }
+    }
+}
+
 /// Builds the primitive sets `spec` names (and nothing else) with their BVHs, and
 /// resolves alpha and max_alpha against the mesh's diagonal, with the messages of
 /// `naming`.
@@ -177,15 +193,7 @@ mod tests {
 
     /// One primitive kind at `alpha_rel` and `beta`, the default tolerance.
     fn spec_rel(kind: PrimitiveKind, alpha_rel: f64, beta: f64) -> ObjectSpec {
-        ObjectSpec {
-            kinds: vec![kind],
-            alpha: None,
-            alpha_rel: Some(alpha_rel),
-            max_alpha: None,
-            max_alpha_rel: None,
-            beta,
-            tolerance: None,
-        }
+        ObjectSpec::relative(vec![kind], alpha_rel, beta)
     }
 
     /// A stream of uniform numbers in [0, 1) from `seed` (a linear congruential generator).
