@@ -182,6 +182,24 @@ impl Camera {
         (self.origin, d.normalize())
     }
 
+    /// Where the ray towards `p` crosses the image plane, in the pixel units of
+    /// [`Camera::ray_through`] (its inverse), or `None` when `p` is not in front of the
+    /// camera (on or behind the plane through the origin facing `forward`). Points
+    /// outside the field of view give positions outside `[0, width] x [0, height]`.
+    pub fn project(&self, p: DVec3) -> Option<(f64, f64)> {
+        let v = p - self.origin;
+        let z = v.dot(self.forward);
+        if z.is_nan() || z <= 0.0 {
+            return None;
+        }
+        let sx = v.dot(self.right) / (z * self.half_height * self.aspect());
+        let sy = v.dot(self.up_cam) / (z * self.half_height);
+        Some((
+            0.5 * (sx + 1.0) * f64::from(self.width),
+            0.5 * (1.0 - sy) * f64::from(self.height),
+        ))
+    }
+
     /// A world-space vector in camera coordinates: x right, y up, z towards the viewer.
     pub fn to_camera_space(&self, n: DVec3) -> DVec3 {
         DVec3::new(n.dot(self.right), n.dot(self.up_cam), -n.dot(self.forward))
@@ -255,6 +273,21 @@ mod tests {
             h,
         )
         .unwrap()
+    }
+
+    #[test]
+    fn project_inverts_ray_through_and_rejects_points_behind() {
+        let c = cam(64, 36);
+        for &(x, y) in &[(0.0, 0.0), (32.0, 18.0), (63.5, 0.25), (-10.0, 50.0)] {
+            let (o, d) = c.ray_through(x, y);
+            for t in [0.1, 3.0, 40.0] {
+                let (px, py) = c.project(o + t * d).expect("in front");
+                close(px, x, 1e-9);
+                close(py, y, 1e-9);
+            }
+        }
+        assert_eq!(c.project(c.origin() - c.forward()), None);
+        assert_eq!(c.project(c.origin()), None);
     }
 
     fn angle_deg(a: DVec3, b: DVec3) -> f64 {

@@ -1,5 +1,5 @@
 //! The image loop: samples traced in parallel by tiles of `TILE x TILE` pixels (each
-//! marched as a cone first, `cone`), shaded with the hit object's MatCap (SPEC 8) using
+//! marched as a cone first, `cone`; the heaviest tiles first, `schedule`), shaded with the hit object's MatCap (SPEC 8) using
 //! the camera-space normal and the object's colours (`albedo::shade_hit`), accumulated
 //! by the film (`crate::film`). A tile's work does not depend on the other tiles, so the
 //! image does not depend on the thread count, and a crop traces the whole image's tiles
@@ -17,6 +17,7 @@
 
 use super::cone::{ConeStats, Tile, trace_tile};
 use super::hit_gap::{self, HitGap};
+use super::schedule;
 use super::tracer::{Hit, RayResult, RayStats, Tracer};
 use crate::camera::Camera;
 use crate::film::accumulate::PixelAccum;
@@ -333,20 +334,18 @@ pub fn render_film(
     let tiles = tiles_over(traced, w, h);
     let tiles_per_row = tiles_per_row(&tiles);
     let done = std::sync::atomic::AtomicU64::new(0);
-    let results: Vec<TileResult> = tiles
-        .into_par_iter()
-        .map(|tile| {
-            if cancelled() {
-                return None;
-            }
-            let r = ctx.trace_tile_samples(tile, &first_pass);
-            let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            if finished.is_multiple_of(tiles_per_row) {
-                progress((finished / tiles_per_row * TILE as u64).min(region.height() as u64));
-            }
-            Some(r)
-        })
-        .collect::<Option<_>>()?;
+    let order = schedule::heaviest_first(tracer.objects(), camera, &tiles);
+    let results: Vec<TileResult> = schedule::run_in_order(&order, |i| {
+        if cancelled() {
+            return None;
+        }
+        let r = ctx.trace_tile_samples(tiles[i], &first_pass);
+        let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        if finished.is_multiple_of(tiles_per_row) {
+            progress((finished / tiles_per_row * TILE as u64).min(region.height() as u64));
+        }
+        Some(r)
+    })?;
     let mut centres = adaptive.then(|| NeighbourView::new(traced));
     for r in &results {
         stats.merge(&r.stats);

@@ -6,6 +6,7 @@ pub mod hit_gap;
 pub mod neighbours;
 pub mod object;
 pub mod options;
+pub mod schedule;
 pub mod signed;
 pub mod step_beta;
 mod stepper;

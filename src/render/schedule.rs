@@ -1,0 +1,220 @@
+//! The order the image loop traces its tiles in: the heaviest first, from one queue.
+//!
+//! Tiles are traced independently (`render::image`), so their order changes no pixel and
+//! no count; it only decides how long the threads wait for each other at the end. On a
+//! view where the object covers a few tiles, those tiles hold nearly all the work (every
+//! hit ray and the near misses around it), and when one of them is the last to start,
+//! the other threads sit idle for most of a tile: on the published full bunny at 480x270
+//! (20-odd of 510 tiles hold its hit rays) two threads took 0.27 s for 0.48 s of
+//! one-thread work.
+//!
+//! Longest processing time first (Graham's list scheduling: each thread takes the next
+//! tile of a shared queue, the heaviest first) leaves at most the last tile's time idle,
+//! and the last tiles are the light ones. A tile's weight is estimated before any ray is
+//! traced from where the surfaces can be: the boxes of each primitive set's BVH nodes
+//! with about `1 / BOXES_PER_SET` of its primitives each are projected onto the image
+//! (the rectangle around their corners' projections, `Camera::project`), and a tile
+//! weighs the number of boxes whose rectangle overlaps it. A box with a corner behind
+//! the camera counts on every tile (it can project anywhere). Ties keep the image order.
+//! The estimate only orders the work; a wrong one costs time, never a different image.
+
+use super::cone::Tile;
+use super::object::TraceObject;
+use crate::camera::Camera;
+use crate::primitives::AnySet;
+use glam::DVec3;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// About how many boxes per primitive set estimate where its surface projects.
+pub const BOXES_PER_SET: usize = 512;
+
+/// The indices of `tiles`, heaviest first by the projected boxes of `objects` seen
+/// through `camera` (module docs); ties in the order of `tiles`.
+pub fn heaviest_first(objects: &[TraceObject], camera: &Camera, tiles: &[Tile]) -> Vec<usize> {
+    let weights = tile_weights(objects, camera, tiles);
+    let mut order: Vec<usize> = (0..tiles.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(weights[i]));
+    order
+}
+
+/// How many projected boxes overlap each of `tiles`.
+pub fn tile_weights(objects: &[TraceObject], camera: &Camera, tiles: &[Tile]) -> Vec<u32> {
+    let rects: Vec<Option<[f64; 4]>> = objects
+        .iter()
+        .flat_map(|o| o.sets.iter())
+        .flat_map(set_boxes)
+        .map(|(lo, hi)| projected_rect(camera, lo, hi))
+        .collect();
+    tiles
+        .iter()
+        .map(|t| {
+            let (x0, y0) = (f64::from(t.x0), f64::from(t.y0));
+            let (x1, y1) = (x0 + f64::from(t.w), y0 + f64::from(t.h));
+            rects
+                .iter()
+                .filter(|r| match r {
+                    None => true,
+                    Some([rx0, ry0, rx1, ry1]) => {
+                        *rx0 <= x1 && *rx1 >= x0 && *ry0 <= y1 && *ry1 >= y0
+                    }
+                })
+                .count() as u32
+        })
+        .collect()
+}
+
+/// The boxes of the BVH nodes of `set` that hold at most `len / BOXES_PER_SET`
+/// primitives (rounded up) and whose parent holds more, and of the leaves above that
+/// size: the tree's cut at about [`BOXES_PER_SET`] boxes.
+fn set_boxes(set: &AnySet) -> Vec<(DVec3, DVec3)> {
+    let nodes = &set.bvh().nodes;
+    let most = set.len().div_ceil(BOXES_PER_SET).max(1) as u32;
+    let mut boxes = Vec::new();
+    let mut stack = if nodes.is_empty() { vec![] } else { vec![0] };
+    while let Some(i) = stack.pop() {
+        let n = &nodes[i];
+        if n.is_leaf() || n.size <= most {
+            boxes.push((n.min.as_dvec3(), n.max.as_dvec3()));
+        } else {
+            stack.extend([i + 1, n.index as usize]);
+        }
+    }
+    boxes
+}
+
+/// The pixel rectangle `[x0, y0, x1, y1]` around the projections of the box's corners,
+/// or `None` when a corner is not in front of the camera.
+fn projected_rect(camera: &Camera, lo: DVec3, hi: DVec3) -> Option<[f64; 4]> {
+    let mut r = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for k in 0..8 {
+        let corner = DVec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        );
+        let (x, y) = camera.project(corner)?;
+        r = [r[0].min(x), r[1].min(y), r[2].max(x), r[3].max(y)];
+    }
+    Some(r)
+}
+
+/// Runs `work(i)` for every index of `order` on the current thread pool, each thread
+/// taking the next index of the queue in `order`'s order, and returns the results by
+/// index (`results[i] = work(i)`), or `None` as soon as any `work` returns `None` (a
+/// cancelled render). `order` must be a permutation of `0..order.len()`.
+pub fn run_in_order<T: Send>(
+    order: &[usize],
+    work: impl Fn(usize) -> Option<T> + Sync,
+) -> Option<Vec<T>> {
+    let next = AtomicUsize::new(0);
+    let workers = rayon::current_num_threads().max(1);
+    let done: Vec<Vec<(usize, Option<T>)>> = (0..workers)
+        .into_par_iter()
+        .map(|_| {
+            let mut done = Vec::new();
+            while let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                let r = work(i);
+                let stop = r.is_none();
+                done.push((i, r));
+                if stop {
+                    // Let the other threads stop at their next tile.
+                    next.store(order.len(), Ordering::Relaxed);
+                    break;
+                }
+            }
+            done
+        })
+        .collect();
+    let mut results: Vec<Option<T>> = (0..order.len()).map(|_| None).collect();
+    for (i, r) in done.into_iter().flatten() {
+        results[i] = Some(r?);
+    }
+    results.into_iter().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::EvalParams;
+    use crate::primitives::PrimitiveKind;
+    use crate::procedural;
+
+    fn tiles(w: u32, h: u32, side: u32) -> Vec<Tile> {
+        (0..h.div_ceil(side))
+            .flat_map(|ty| {
+                (0..w.div_ceil(side)).map(move |tx| Tile {
+                    x0: tx * side,
+                    y0: ty * side,
+                    w: side.min(w - tx * side),
+                    h: side.min(h - ty * side),
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn results_come_back_by_index_whatever_the_order() {
+        let order = [3, 0, 4, 1, 2];
+        let r = run_in_order(&order, |i| Some(10 * i)).unwrap();
+        assert_eq!(r, vec![0, 10, 20, 30, 40]);
+        assert_eq!(run_in_order(&order, |i| (i != 4).then_some(i)), None);
+        assert_eq!(run_in_order::<u8>(&[], |_| None), Some(vec![]));
+    }
+
+    #[test]
+    fn tiles_where_a_small_object_projects_come_first() {
+        // A torus of radius 0.15 at the world origin, seen from 5 units away: it covers
+        // the middle of a 160x96 image and no tile near its corners.
+        let mesh = procedural::torus(0.1, 0.05, 24, 12);
+        let set = AnySet::build(&mesh, PrimitiveKind::Triangles).unwrap();
+        let object = TraceObject::new(vec![set], EvalParams::new(100.0, 1.0, 0.5));
+        let camera = Camera::new(
+            DVec3::new(0.0, 0.0, 5.0),
+            DVec3::ZERO,
+            DVec3::Y,
+            53.13,
+            160,
+            96,
+        )
+        .unwrap();
+        let tiles = tiles(160, 96, 16);
+        let weights = tile_weights(std::slice::from_ref(&object), &camera, &tiles);
+        let order = heaviest_first(std::slice::from_ref(&object), &camera, &tiles);
+        let (cx, cy) = camera.project(DVec3::ZERO).unwrap();
+        let centre = tiles
+            .iter()
+            .position(|t| {
+                (f64::from(t.x0)..f64::from(t.x0 + t.w)).contains(&cx)
+                    && (f64::from(t.y0)..f64::from(t.y0 + t.h)).contains(&cy)
+            })
+            .unwrap();
+        assert!(weights[centre] > 0, "{weights:?}");
+        assert_eq!(weights[0], 0, "the top-left tile sees no box: {weights:?}");
+        let first_empty = order.iter().position(|&i| weights[i] == 0).unwrap();
+        assert!(order[..first_empty].contains(&centre));
+        assert!(order[..first_empty].iter().all(|&i| weights[i] > 0));
+        // Ties keep the image order.
+        let empties = &order[first_empty..];
+        assert!(empties.windows(2).all(|w| w[0] < w[1]));
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..tiles.len()).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn a_box_around_the_camera_weighs_on_every_tile() {
+        let mesh = procedural::sphere_points(1.0, 2000);
+        let set = AnySet::build(&mesh, PrimitiveKind::Points).unwrap();
+        let object = TraceObject::new(vec![set], EvalParams::new(10.0, 1.0, 0.5));
+        let camera = Camera::new(DVec3::ZERO, DVec3::Z, DVec3::Y, 60.0, 64, 64).unwrap();
+        let tiles = tiles(64, 64, 16);
+        let weights = tile_weights(std::slice::from_ref(&object), &camera, &tiles);
+        assert!(weights.iter().all(|&w| w >= 1), "{weights:?}");
+    }
+}
