@@ -334,7 +334,7 @@ pub fn render_film(
     let tiles = tiles_over(traced, w, h);
     let tiles_per_row = tiles_per_row(&tiles);
     let done = std::sync::atomic::AtomicU64::new(0);
-    let order = schedule::heaviest_first(tracer.objects(), camera, &tiles);
+    let order = schedule::heaviest_first(tracer.objects(), camera, &tiles, TILE);
     let results: Vec<TileResult> = schedule::run_in_order(&order, |i| {
         if cancelled() {
             return None;

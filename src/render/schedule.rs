@@ -29,39 +29,96 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// About how many boxes per primitive set estimate where its surface projects.
 pub const BOXES_PER_SET: usize = 512;
 
-/// The indices of `tiles`, heaviest first by the projected boxes of `objects` seen
-/// through `camera` (module docs); ties in the order of `tiles`.
-pub fn heaviest_first(objects: &[TraceObject], camera: &Camera, tiles: &[Tile]) -> Vec<usize> {
-    let weights = tile_weights(objects, camera, tiles);
+/// The indices of `tiles` (cells of a grid of `side`-pixel squares, [`tile_weights`]),
+/// heaviest first by the projected boxes of `objects` seen through `camera` (module
+/// docs); ties in the order of `tiles`.
+pub fn heaviest_first(
+    objects: &[TraceObject],
+    camera: &Camera,
+    tiles: &[Tile],
+    side: u32,
+) -> Vec<usize> {
+    let weights = tile_weights(objects, camera, tiles, side);
     let mut order: Vec<usize> = (0..tiles.len()).collect();
     order.sort_by_key(|&i| std::cmp::Reverse(weights[i]));
     order
 }
 
-/// How many projected boxes overlap each of `tiles`.
-pub fn tile_weights(objects: &[TraceObject], camera: &Camera, tiles: &[Tile]) -> Vec<u32> {
-    let rects: Vec<Option<[f64; 4]>> = objects
+/// How many projected boxes overlap each of `tiles` (their pixel rectangles, edges
+/// included), a box with a corner behind the camera counting on every tile. The tiles
+/// are cells of one grid of `side x side` pixels from the image's corner (the last row
+/// and column may be narrower), as the image loop makes them.
+pub fn tile_weights(
+    objects: &[TraceObject],
+    camera: &Camera,
+    tiles: &[Tile],
+    side: u32,
+) -> Vec<u32> {
+    let mut weights = vec![0u32; tiles.len()];
+    if tiles.is_empty() {
+        return weights;
+    }
+    // The tiles' grid cells, and where each tile sits among them.
+    let cell = |t: &Tile| ((t.x0 / side) as usize, (t.y0 / side) as usize);
+    let (cx0, cy0) = tiles
+        .iter()
+        .map(cell)
+        .fold((usize::MAX, usize::MAX), |a, c| {
+            (a.0.min(c.0), a.1.min(c.1))
+        });
+    let (cx1, cy1) = tiles
+        .iter()
+        .map(cell)
+        .fold((0, 0), |a, c| (a.0.max(c.0), a.1.max(c.1)));
+    let columns = cx1 - cx0 + 1;
+    let mut at = vec![usize::MAX; columns * (cy1 - cy0 + 1)];
+    for (i, t) in tiles.iter().enumerate() {
+        let (cx, cy) = cell(t);
+        at[(cy - cy0) * columns + cx - cx0] = i;
+    }
+    // The cells a pixel interval `[a, b]` touches, within `lo..=hi`: a tile's interval
+    // `[k side, k side + w]` includes its far edge.
+    let span = |a: f64, b: f64, lo: usize, hi: usize| {
+        let side = f64::from(side);
+        let first = ((a / side).ceil() - 1.0).max(lo as f64);
+        let last = (b / side).floor().min(hi as f64);
+        (first as usize, last as usize)
+    };
+    let mut everywhere = 0u32;
+    for rect in objects
         .iter()
         .flat_map(|o| o.sets.iter())
         .flat_map(set_boxes)
         .map(|(lo, hi)| projected_rect(camera, lo, hi))
-        .collect();
-    tiles
-        .iter()
-        .map(|t| {
-            let (x0, y0) = (f64::from(t.x0), f64::from(t.y0));
-            let (x1, y1) = (x0 + f64::from(t.w), y0 + f64::from(t.h));
-            rects
-                .iter()
-                .filter(|r| match r {
-                    None => true,
-                    Some([rx0, ry0, rx1, ry1]) => {
-                        *rx0 <= x1 && *rx1 >= x0 && *ry0 <= y1 && *ry1 >= y0
-                    }
-                })
-                .count() as u32
-        })
-        .collect()
+    {
+        let Some([x0, y0, x1, y1]) = rect else {
+            everywhere += 1;
+            continue;
+        };
+        let (first_x, last_x) = span(x0, x1, cx0, cx1);
+        let (first_y, last_y) = span(y0, y1, cy0, cy1);
+        if x1 < 0.0 || y1 < 0.0 || first_x > last_x || first_y > last_y {
+            continue;
+        }
+        for cy in first_y..=last_y {
+            for cx in first_x..=last_x {
+                let i = at[(cy - cy0) * columns + cx - cx0];
+                // A tile's own width decides at the image's narrower last column and row.
+                if let Some(t) = tiles.get(i)
+                    && f64::from(t.x0) <= x1
+                    && f64::from(t.x0 + t.w) >= x0
+                    && f64::from(t.y0) <= y1
+                    && f64::from(t.y0 + t.h) >= y0
+                {
+                    weights[i] += 1;
+                }
+            }
+        }
+    }
+    for w in &mut weights {
+        *w += everywhere;
+    }
+    weights
 }
 
 /// The boxes of the BVH nodes of `set` that hold at most `len / BOXES_PER_SET`
@@ -184,8 +241,8 @@ mod tests {
         )
         .unwrap();
         let tiles = tiles(160, 96, 16);
-        let weights = tile_weights(std::slice::from_ref(&object), &camera, &tiles);
-        let order = heaviest_first(std::slice::from_ref(&object), &camera, &tiles);
+        let weights = tile_weights(std::slice::from_ref(&object), &camera, &tiles, 16);
+        let order = heaviest_first(std::slice::from_ref(&object), &camera, &tiles, 16);
         let (cx, cy) = camera.project(DVec3::ZERO).unwrap();
         let centre = tiles
             .iter()
@@ -208,13 +265,54 @@ mod tests {
     }
 
     #[test]
+    fn the_grid_counts_what_testing_every_box_against_every_tile_counts() {
+        let mesh = procedural::torus(0.5, 0.2, 32, 16);
+        let set = AnySet::build(&mesh, PrimitiveKind::Edges).unwrap();
+        let object = TraceObject::new(vec![set], EvalParams::new(30.0, 30.0, 0.5));
+        let boxes = set_boxes(&object.sets[0]);
+        for (origin, (w, h)) in [
+            (DVec3::new(0.3, 0.8, 2.5), (200, 120)),
+            (DVec3::new(-1.5, 0.2, 0.4), (97, 61)),
+            (DVec3::new(0.0, 0.1, 0.6), (64, 48)),
+        ] {
+            let camera = Camera::new(origin, DVec3::ZERO, DVec3::Y, 53.13, w, h).unwrap();
+            let all = tiles(w, h, 16);
+            // A crop's tiles: the grid's cells from (1, 1) on.
+            let crop: Vec<Tile> = all
+                .iter()
+                .copied()
+                .filter(|t| t.x0 >= 16 && t.y0 >= 16)
+                .collect();
+            for tiles in [all, crop] {
+                let got = tile_weights(std::slice::from_ref(&object), &camera, &tiles, 16);
+                let want: Vec<u32> = tiles
+                    .iter()
+                    .map(|t| {
+                        let (x0, y0) = (f64::from(t.x0), f64::from(t.y0));
+                        let (x1, y1) = (x0 + f64::from(t.w), y0 + f64::from(t.h));
+                        boxes
+                            .iter()
+                            .filter(|&&(lo, hi)| match projected_rect(&camera, lo, hi) {
+                                None => true,
+                                Some([a, b, c, d]) => a <= x1 && c >= x0 && b <= y1 && d >= y0,
+                            })
+                            .count() as u32
+                    })
+                    .collect();
+                assert_eq!(got, want, "camera at {origin}");
+                assert!(got.iter().any(|&w| w > 0));
+            }
+        }
+    }
+
+    #[test]
     fn a_box_around_the_camera_weighs_on_every_tile() {
         let mesh = procedural::sphere_points(1.0, 2000);
         let set = AnySet::build(&mesh, PrimitiveKind::Points).unwrap();
         let object = TraceObject::new(vec![set], EvalParams::new(10.0, 1.0, 0.5));
         let camera = Camera::new(DVec3::ZERO, DVec3::Z, DVec3::Y, 60.0, 64, 64).unwrap();
         let tiles = tiles(64, 64, 16);
-        let weights = tile_weights(std::slice::from_ref(&object), &camera, &tiles);
+        let weights = tile_weights(std::slice::from_ref(&object), &camera, &tiles, 16);
         assert!(weights.iter().all(|&w| w >= 1), "{weights:?}");
     }
 }
