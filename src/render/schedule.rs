@@ -15,7 +15,7 @@
 //! with about `1 / BOXES_PER_SET` of its primitives each are projected onto the image
 //! (the rectangle around their corners' projections, `Camera::project`), and a tile
 //! weighs the number of boxes whose rectangle overlaps it. A box with a corner behind
-//! the camera counts on every tile (it can project anywhere). Ties keep the image order.
+//! the camera (or on its plane) counts on every tile: it can project anywhere. Ties keep the image order.
 //! The estimate only orders the work; a wrong one costs time, never a different image.
 
 use super::cone::Tile;
@@ -141,7 +141,8 @@ fn set_boxes(set: &AnySet) -> Vec<(DVec3, DVec3)> {
 }
 
 /// The pixel rectangle `[x0, y0, x1, y1]` around the projections of the box's corners,
-/// or `None` when a corner is not in front of the camera.
+/// or `None` when a corner is not in front of the camera (or so close to its plane that
+/// its projection is not finite).
 fn projected_rect(camera: &Camera, lo: DVec3, hi: DVec3) -> Option<[f64; 4]> {
     let mut r = [
         f64::INFINITY,
@@ -155,7 +156,9 @@ fn projected_rect(camera: &Camera, lo: DVec3, hi: DVec3) -> Option<[f64; 4]> {
             if k & 2 == 0 { lo.y } else { hi.y },
             if k & 4 == 0 { lo.z } else { hi.z },
         );
-        let (x, y) = camera.project(corner)?;
+        let (x, y) = camera
+            .project(corner)
+            .filter(|p| p.0.is_finite() && p.1.is_finite())?;
         r = [r[0].min(x), r[1].min(y), r[2].max(x), r[3].max(y)];
     }
     Some(r)
