@@ -81,6 +81,20 @@ pub enum TriFeature {
     Degenerate,
 }
 
+impl TriFeature {
+    /// The vertex (0, 1, 2 for `a`, `b`, `c`) the feature is, if it is one: the closest
+    /// point's barycentrics `(s, t)` are then exactly `(0, 0)`, `(1, 0)` or `(0, 1)`.
+    #[inline]
+    pub fn corner(self) -> Option<usize> {
+        match self {
+            TriFeature::VertexA => Some(0),
+            TriFeature::VertexB => Some(1),
+            TriFeature::VertexC => Some(2),
+            _ => None,
+        }
+    }
+}
+
 /// Closest point on a triangle with barycentrics `point = a + s (b - a) + t (c - a)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TriangleClosest {

@@ -144,23 +144,84 @@ pub fn triangle_table_row(vmax: f32, emax: f32) -> u16 {
 /// [`triangle_table_row`] of valences outside the table.
 pub const NOT_TABULATED: u16 = u16::MAX;
 
+/// The barycentrics `(s, t)` of a triangle's corners `a`, `b`, `c` (0, 1, 2).
+pub const TRI_CORNERS: [(f64, f64); 3] = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)];
+
+/// The triangle weight at one of its corners, as the general formulas give it there
+/// (what a term whose closest point is a vertex needs; most are, for a query a few
+/// triangles away): tabulated with the coefficients, so that such a term evaluates no
+/// polynomial and its results are the general path's to the last bit.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TriCorner {
+    /// [`triangle_w_grad`]'s `W` there.
+    pub raw: f64,
+    /// `ws * 0 + wt * 0` (per component, `ws`, `wt` its partials there): what the
+    /// weight gradient's sum `ws grad s + wt grad t` is at a vertex, where both
+    /// barycentric gradients are zero (its zeros' signs included).
+    pub zero: DVec3,
+    /// [`triangle_w_value`] there (the value paths sum the polynomial in another order,
+    /// so it may round differently; [`triangle_w_directional`]'s `W` is the same sum).
+    pub value: f64,
+}
+
+impl TriCorner {
+    /// Corner `i` (0, 1, 2 for `a`, `b`, `c`) of the weight with coefficients `k`.
+    pub fn of(k: &[f64; 13], i: usize) -> TriCorner {
+        let (s, t) = TRI_CORNERS[i];
+        let (raw, ws, wt) = triangle_w_grad(s, t, k);
+        TriCorner {
+            raw,
+            zero: ws * DVec3::ZERO + wt * DVec3::ZERO,
+            value: triangle_w_value(s, t, k),
+        }
+    }
+}
+
+/// A row of the coefficient table: `k` and its three corners.
+struct TriRow {
+    k: [f64; 13],
+    corners: [TriCorner; 3],
+}
+
+/// The table of the common valences' coefficients, computed once.
+#[inline]
+fn triangle_table() -> &'static [TriRow] {
+    static TABLE: std::sync::OnceLock<Vec<TriRow>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        (1..=TABLE_VMAX)
+            .flat_map(|v| {
+                (1..=TABLE_EMAX).map(move |e| {
+                    let k = triangle_coefficients(v as f64, e as f64);
+                    TriRow {
+                        k,
+                        corners: std::array::from_fn(|i| TriCorner::of(&k, i)),
+                    }
+                })
+            })
+            .collect()
+    })
+}
+
 /// [`triangle_coefficients`] for valences `vmax`, `emax` whose [`triangle_table_row`] is
 /// `row`: from a table computed once for the common valences, else into `buf`.
 #[inline]
 pub fn triangle_k(row: u16, vmax: f32, emax: f32, buf: &mut [f64; 13]) -> &[f64; 13] {
-    static TABLE: std::sync::OnceLock<Vec<[f64; 13]>> = std::sync::OnceLock::new();
     if row != NOT_TABULATED {
-        let table = TABLE.get_or_init(|| {
-            (1..=TABLE_VMAX)
-                .flat_map(|v| {
-                    (1..=TABLE_EMAX).map(move |e| triangle_coefficients(v as f64, e as f64))
-                })
-                .collect()
-        });
-        &table[row as usize]
+        &triangle_table()[row as usize].k
     } else {
         *buf = triangle_coefficients(vmax as f64, emax as f64);
         buf
+    }
+}
+
+/// [`TriCorner::of`] corner `i` of the weight of valences `vmax`, `emax` (table row
+/// `row`, as [`triangle_k`]).
+#[inline]
+pub fn triangle_corner(row: u16, vmax: f32, emax: f32, i: usize) -> TriCorner {
+    if row != NOT_TABULATED {
+        triangle_table()[row as usize].corners[i]
+    } else {
+        TriCorner::of(&triangle_coefficients(vmax as f64, emax as f64), i)
     }
 }
 
