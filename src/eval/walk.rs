@@ -357,7 +357,6 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
         while let Some(e) = self.stack.pop() {
             self.stats.nodes += 1;
             let reach2 = self.reach2();
-            let budget2 = self.budget2();
             if e.r2 > reach2 {
                 self.stats.pruned += 1;
                 continue;
@@ -369,6 +368,8 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
                 self.stats.exact += e.count;
                 continue;
             }
+            // (Only a wide node's slots need it: not computed for a leaf.)
+            let budget2 = self.budget2();
             let node = &wide[e.i as usize];
             let d2 = node.distances2(self.x);
             let mut open = Open::new();
