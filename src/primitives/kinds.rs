@@ -375,7 +375,9 @@ impl Primitive for Triangle {
         let (w, dw) = scale.apply(raw);
         (d, w, slope(v, d, u), dw * draw / w)
     }
-    #[inline]
+    /// Inlined where the sink takes the term (most terms are at a vertex: their term
+    /// stays in registers), the rest of the weight out of line.
+    #[inline(always)]
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term {
         let (cl, v, d) = self.offset(x);
         if let Some(i) = cl.feature.corner() {
@@ -390,6 +392,20 @@ impl Primitive for Triangle {
                 grad_w: if dw != 0.0 { dw * c.zero } else { DVec3::ZERO },
             };
         }
+        self.term_on_edge_or_face(&cl, v, d, scale)
+    }
+}
+
+impl Triangle {
+    /// [`Primitive::term`] where the closest point is not a vertex.
+    #[inline(never)]
+    fn term_on_edge_or_face(
+        &self,
+        cl: &TriangleClosest,
+        v: DVec3,
+        d: f64,
+        scale: &WeightScale,
+    ) -> Term {
         let mut buf = [0.0; 13];
         let k = weights::triangle_k(self.row, self.vmax, self.emax, &mut buf);
         let (raw, ws, wt) = weights::triangle_w_grad(cl.s, cl.t, k);
