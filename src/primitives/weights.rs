@@ -381,27 +381,36 @@ pub fn edge_w<T: Real>(t: T, c: [T; 4]) -> (T, T) {
 
 /// Attenuated, clamped weight of one primitive: `w = (max_adj * clamp(W))^q` and the
 /// factor `dw/dW` (zero where the clamp is active), from the raw polynomial value.
+/// Made by [`WeightScale::new`] (which also computes `max_adj^q`; the fields are read,
+/// not changed, after it).
 #[derive(Clone, Copy, Debug)]
 pub struct WeightScale {
     /// Largest valence of the primitive set (SPEC 1).
     pub max_adj: f64,
     /// Attenuation exponent `q = min(alpha / max_alpha, 1)` (SPEC 5).
     pub q: f64,
+    /// `max_adj^q` ([`WeightScale::max_weight`]), once: every leaf of a walk may need
+    /// it (a weight clamped from above), and the compiler hoists its `powf` out of a
+    /// leaf's loop, so it was computed once per leaf.
+    w_max: f64,
 }
 
 impl WeightScale {
     pub fn new(max_adj: f64, alpha: f64, max_alpha: f64) -> WeightScale {
-        WeightScale {
+        let mut scale = WeightScale {
             max_adj: max_adj.max(1.0),
             q: (alpha / max_alpha).min(1.0),
-        }
+            w_max: 0.0,
+        };
+        scale.w_max = scale.pow(scale.max_adj);
+        scale
     }
 
     /// The largest weight any primitive of the set can have, `max_adj^q`: the weight of
     /// a Barnes-Hut far-field term (SPEC 6).
     #[inline]
     pub fn max_weight(&self) -> f64 {
-        self.pow(self.max_adj)
+        self.w_max
     }
 
     #[inline]
@@ -649,6 +658,25 @@ mod tests {
             assert!(d0.abs() < 1e-12 && d1.abs() < 1e-12);
         }
         assert_eq!(edge_quartic(1.0, 1.0), [1.0, 0.0, 0.0, 0.0]);
+    }
+
+    /// `max_weight` (computed once by `new`) is `max_adj^q` on each of `pow`'s branches.
+    #[test]
+    fn max_weight_is_max_adj_to_the_q() {
+        for (max_adj, alpha, max_alpha) in [(12.0, 5.0, 5.0), (12.0, 1.0, 2.0), (7.0, 3.0, 10.0)] {
+            let ws = WeightScale::new(max_adj, alpha, max_alpha);
+            let want = match ws.q {
+                1.0 => max_adj,
+                0.5 => max_adj.sqrt(),
+                q => max_adj.powf(q),
+            };
+            assert_eq!(
+                ws.max_weight().to_bits(),
+                want.to_bits(),
+                "{max_adj} {alpha}"
+            );
+            assert_eq!(ws.apply(2.0).0, want);
+        }
     }
 
     #[test]
