@@ -393,14 +393,18 @@ pub struct WeightScale {
     /// it (a weight clamped from above), and the compiler hoists its `powf` out of a
     /// leaf's loop, so it was computed once per leaf.
     w_max: f64,
+    /// `1 / max_adj`, the floor of `W`, once (not a division per term).
+    lo: f64,
 }
 
 impl WeightScale {
     pub fn new(max_adj: f64, alpha: f64, max_alpha: f64) -> WeightScale {
+        let max_adj = max_adj.max(1.0);
         let mut scale = WeightScale {
-            max_adj: max_adj.max(1.0),
+            max_adj,
             q: (alpha / max_alpha).min(1.0),
             w_max: 0.0,
+            lo: 1.0 / max_adj,
         };
         scale.w_max = scale.pow(scale.max_adj);
         scale
@@ -427,7 +431,7 @@ impl WeightScale {
     /// `w` alone for the raw polynomial value `raw` (same as `apply(raw).0`).
     #[inline]
     pub fn weight(&self, raw: f64) -> f64 {
-        if raw <= 1.0 / self.max_adj {
+        if raw <= self.lo {
             1.0
         } else if raw >= 1.0 || raw.is_nan() {
             self.max_weight()
@@ -439,8 +443,7 @@ impl WeightScale {
     /// `(w, dw/dW)` for the raw polynomial value `raw`.
     #[inline]
     pub fn apply(&self, raw: f64) -> (f64, f64) {
-        let lo = 1.0 / self.max_adj;
-        if raw <= lo {
+        if raw <= self.lo {
             (1.0, 0.0)
         } else if raw >= 1.0 || raw.is_nan() {
             (self.max_weight(), 0.0)
