@@ -41,6 +41,8 @@ pub struct Accumulator {
     /// rather than as `s` minus the far terms: those can exceed the exact sum by many
     /// orders of magnitude, and the difference would be rounding.)
     lower: f64,
+    /// `1 / alpha`, once.
+    inv_alpha: f64,
 }
 
 impl Accumulator {
@@ -55,6 +57,7 @@ impl Accumulator {
             naive_g: DVec3::ZERO,
             pruned: 0.0,
             lower: 0.0,
+            inv_alpha: 1.0 / alpha,
         }
     }
 
@@ -89,10 +92,9 @@ impl Accumulator {
 
     #[inline]
     fn push<const EXACT: bool>(&mut self, d: f64, w: f64, dir: DVec3, grad_w: DVec3) -> f64 {
-        let inv_alpha = 1.0 / self.alpha;
         self.shift(d);
         let e = (-self.alpha * (d - self.m)).exp();
-        let gterm = w * dir - grad_w * inv_alpha;
+        let gterm = w * dir - grad_w * self.inv_alpha;
         self.s += w * e;
         self.g += e * gterm;
         if EXACT {

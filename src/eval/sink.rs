@@ -242,7 +242,14 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
         let m = self.acc.m;
         let e = self.acc.add(t.d, t.w, t.dir, t.grad_w);
         if SLOPE {
-            let a = self.term_slope(t.dir.dot(self.u), t.grad_w.dot(self.u) / t.w);
+            // A zero slope of the weight along the ray (every term at a vertex) gives
+            // the distance's slope without the division: `term_slope` of a zero `l`.
+            let (a, gu) = (t.dir.dot(self.u), t.grad_w.dot(self.u));
+            let a = if gu == 0.0 {
+                a
+            } else {
+                self.term_slope(a, gu / t.w)
+            };
             self.add_slope(m, e, a);
         }
     }

@@ -45,32 +45,6 @@ fn slot_box(node: &Node4, k: usize) -> (DVec3, DVec3) {
     )
 }
 
-/// Children of a node to open, as (squared distance, slot), farthest first.
-struct Open {
-    list: [(f64, usize); 4],
-    n: usize,
-}
-
-impl Open {
-    fn new() -> Open {
-        Open {
-            list: [(0.0, 0); 4],
-            n: 0,
-        }
-    }
-
-    #[inline]
-    fn insert(&mut self, d2: f64, k: usize) {
-        let mut h = self.n;
-        while h > 0 && self.list[h - 1].0 < d2 {
-            self.list[h] = self.list[h - 1];
-            h -= 1;
-        }
-        self.list[h] = (d2, k);
-        self.n += 1;
-    }
-}
-
 /// Far-field terms whose closest-box value is below `exp(-SIGNIFICANT)` of the nearest
 /// distance's term take the closest-box form even when moments are kept: their share of
 /// the sum is too small for the tighter bound to move `s`.
@@ -357,7 +331,6 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
         while let Some(e) = self.stack.pop() {
             self.stats.nodes += 1;
             let reach2 = self.reach2();
-            let budget2 = self.budget2();
             if e.r2 > reach2 {
                 self.stats.pruned += 1;
                 continue;
@@ -369,25 +342,36 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
                 self.stats.exact += e.count;
                 continue;
             }
+            // (Only a wide node's slots need it: not computed for a leaf.)
+            let budget2 = self.budget2();
             let node = &wide[e.i as usize];
             let d2 = node.distances2(self.x);
-            let mut open = Open::new();
+            // The children to open go on the stack above `open`, farthest first.
+            let open = self.stack.len();
             for j in 0..2 {
-                self.middle(node, e.i, j, &d2, (reach2, budget2), &mut open);
+                self.middle(node, e.i, j, &d2, (reach2, budget2), open);
             }
-            self.push(node, &open);
         }
     }
 
+    /// Pushes slot `k` of `node` at squared distance `d2` among the children opened
+    /// above stack position `open`, kept farthest first (a child as far as one already
+    /// there goes above it), so that the nearest is popped first.
     #[inline(always)]
-    fn push(&mut self, node: &Node4, open: &Open) {
-        for &(r2, k) in &open.list[..open.n] {
-            self.stack.push(Entry {
-                i: node.child[k],
-                count: node.count[k],
-                r2,
-            });
+    fn open(&mut self, node: &Node4, k: usize, d2: f64, open: usize) {
+        let e = Entry {
+            i: node.child[k],
+            count: node.count[k],
+            r2: d2,
+        };
+        let stack = &mut *self.stack;
+        stack.push(e);
+        let mut h = stack.len() - 1;
+        while h > open && stack[h - 1].r2 < d2 {
+            stack[h] = stack[h - 1];
+            h -= 1;
         }
+        stack[h] = e;
     }
 
     /// Decides middle `j` of wide node `i`: pruned or far field as a whole, at the
@@ -401,7 +385,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
         j: usize,
         d2: &[f64; 4],
         (reach2, budget2): (f64, f64),
-        open: &mut Open,
+        open: usize,
     ) {
         let near = if d2[2 * j] <= d2[2 * j + 1] {
             2 * j
@@ -493,7 +477,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
         k: usize,
         d2k: f64,
         (reach2, budget2): (f64, f64),
-        open: &mut Open,
+        open: usize,
     ) {
         let c = node.count[k];
         if c == EMPTY {
@@ -514,7 +498,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
             self.far_slot(node, i, k, d2k);
             return;
         }
-        open.insert(d2k, k);
+        self.open(node, k, d2k, open);
     }
 }
 

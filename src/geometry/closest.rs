@@ -81,6 +81,20 @@ pub enum TriFeature {
     Degenerate,
 }
 
+impl TriFeature {
+    /// The vertex (0, 1, 2 for `a`, `b`, `c`) the feature is, if it is one: the closest
+    /// point's barycentrics `(s, t)` are then exactly `(0, 0)`, `(1, 0)` or `(0, 1)`.
+    #[inline]
+    pub fn corner(self) -> Option<usize> {
+        match self {
+            TriFeature::VertexA => Some(0),
+            TriFeature::VertexB => Some(1),
+            TriFeature::VertexC => Some(2),
+            _ => None,
+        }
+    }
+}
+
 /// Closest point on a triangle with barycentrics `point = a + s (b - a) + t (c - a)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TriangleClosest {
@@ -135,22 +149,36 @@ pub fn closest_on_triangle_ordered(
 ) -> TriangleClosest {
     let solved = match order {
         // The largest angle is at `a`: no rotation.
-        0 => closest_from_largest_angle(x, a, b, c),
-        // Largest angle at `b`: solve for (b, c, a), then map back.
-        1 => closest_from_largest_angle(x, b, c, a).map(|r| {
-            let [ub, uc, _] = weights_of(&r);
-            let feature = rotate_feature(r.feature, [F::VertexB, F::VertexC, F::VertexA]);
-            tri(r.point, ub, uc, feature)
-        }),
-        // Largest angle at `c`: solve for (c, a, b), then map back.
-        2 => closest_from_largest_angle(x, c, a, b).map(|r| {
-            let [uc, _, ub] = weights_of(&r);
-            let feature = rotate_feature(r.feature, [F::VertexC, F::VertexA, F::VertexB]);
-            tri(r.point, ub, uc, feature)
-        }),
+        0 => closest_from_largest_angle::<0>(x, a, b, c),
+        // Largest angle at `b`: solve for (b, c, a), results named back.
+        1 => closest_from_largest_angle::<1>(x, b, c, a),
+        // Largest angle at `c`: solve for (c, a, b), results named back.
+        2 => closest_from_largest_angle::<2>(x, c, a, b),
         _ => None,
     };
     solved.unwrap_or_else(|| closest_on_degenerate_triangle(x, a, b, c))
+}
+
+/// A result of the solve rotated by `R` (0: none; 1: solved for `(b, c, a)`; 2: for `(c,
+/// a, b)`), its barycentrics and feature in the solve's own names, expressed in the
+/// caller's. Inlined at each of the solve's returns, where the feature is a constant,
+/// so that the renaming costs nothing there.
+#[inline(always)]
+fn named<const R: u8>(point: DVec3, s: f64, t: f64, feature: TriFeature) -> TriangleClosest {
+    let r = tri(point, s, t, feature);
+    match R {
+        0 => r,
+        1 => {
+            let [ub, uc, _] = weights_of(&r);
+            let feature = rotate_feature(r.feature, [F::VertexB, F::VertexC, F::VertexA]);
+            tri(r.point, ub, uc, feature)
+        }
+        _ => {
+            let [uc, _, ub] = weights_of(&r);
+            let feature = rotate_feature(r.feature, [F::VertexC, F::VertexA, F::VertexB]);
+            tri(r.point, ub, uc, feature)
+        }
+    }
 }
 
 /// The vertex with the largest angle: the one opposite the longest edge (0, 1, 2).
@@ -205,7 +233,7 @@ use TriFeature as F;
 
 /// Barycentric weights `(u_a, u_b, u_c)` of a result in its own vertex order, with the
 /// weights that are zero on its feature set exactly (not `1 - s - t` rounded).
-#[inline]
+#[inline(always)]
 fn weights_of(r: &TriangleClosest) -> [f64; 3] {
     let ua = match r.feature {
         F::VertexB | F::VertexC | F::EdgeBC => 0.0,
@@ -217,7 +245,7 @@ fn weights_of(r: &TriangleClosest) -> [f64; 3] {
 
 /// The feature of a rotated solve in the caller's names; `v` names the rotated solve's
 /// vertices A, B, C.
-#[inline]
+#[inline(always)]
 fn rotate_feature(f: TriFeature, v: [TriFeature; 3]) -> TriFeature {
     let edge = |p: TriFeature, q: TriFeature| match (p, q) {
         (F::VertexA, F::VertexB) | (F::VertexB, F::VertexA) => F::EdgeAB,
@@ -238,42 +266,47 @@ fn rotate_feature(f: TriFeature, v: [TriFeature; 3]) -> TriFeature {
 /// Ericson's Voronoi-region solve with `a` at the triangle's largest angle, for a
 /// triangle that [`triangle_order`] found not degenerate; `None` when the face solve is
 /// not finite (which only rounding at the degeneracy threshold can cause).
-#[inline]
-fn closest_from_largest_angle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<TriangleClosest> {
+#[inline(always)]
+fn closest_from_largest_angle<const R: u8>(
+    x: DVec3,
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+) -> Option<TriangleClosest> {
     let ab = b - a;
     let ac = c - a;
     let ap = x - a;
     let d1 = ab.dot(ap);
     let d2 = ac.dot(ap);
     if d1 <= 0.0 && d2 <= 0.0 {
-        return Some(tri(a, 0.0, 0.0, F::VertexA));
+        return Some(named::<R>(a, 0.0, 0.0, F::VertexA));
     }
     let bp = x - b;
     let d3 = ab.dot(bp);
     let d4 = ac.dot(bp);
     if d3 >= 0.0 && d4 <= d3 {
-        return Some(tri(b, 1.0, 0.0, F::VertexB));
+        return Some(named::<R>(b, 1.0, 0.0, F::VertexB));
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
         let v = d1 / (d1 - d3);
-        return Some(tri(a + v * ab, v, 0.0, F::EdgeAB));
+        return Some(named::<R>(a + v * ab, v, 0.0, F::EdgeAB));
     }
     let cp = x - c;
     let d5 = ab.dot(cp);
     let d6 = ac.dot(cp);
     if d6 >= 0.0 && d5 <= d6 {
-        return Some(tri(c, 0.0, 1.0, F::VertexC));
+        return Some(named::<R>(c, 0.0, 1.0, F::VertexC));
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
         let w = d2 / (d2 - d6);
-        return Some(tri(a + w * ac, 0.0, w, F::EdgeAC));
+        return Some(named::<R>(a + w * ac, 0.0, w, F::EdgeAC));
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
         let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return Some(tri(b + w * (c - b), 1.0 - w, w, F::EdgeBC));
+        return Some(named::<R>(b + w * (c - b), 1.0 - w, w, F::EdgeBC));
     }
     let denom = 1.0 / (va + vb + vc);
     let v = vb * denom;
@@ -281,10 +314,10 @@ fn closest_from_largest_angle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<
     if !(v.is_finite() && w.is_finite()) {
         return None;
     }
-    Some(tri(a + ab * v + ac * w, v, w, F::Face))
+    Some(named::<R>(a + ab * v + ac * w, v, w, F::Face))
 }
 
-#[inline]
+#[inline(always)]
 fn tri(point: DVec3, s: f64, t: f64, feature: TriFeature) -> TriangleClosest {
     TriangleClosest {
         point,
@@ -333,6 +366,54 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         }
+    }
+
+    /// The rotated solves name their results back at each return (`named`): the same
+    /// as solving unrotated on the rotated vertices and renaming the result afterwards,
+    /// to the last bit, at every feature (queries near vertices, edges and the face).
+    #[test]
+    fn rotated_solves_rename_as_renaming_afterwards() {
+        let mut r = uniform(99);
+        let rename = |res: TriangleClosest, order: u8| match order {
+            1 => {
+                let [ub, uc, _] = weights_of(&res);
+                let f = rotate_feature(res.feature, [F::VertexB, F::VertexC, F::VertexA]);
+                tri(res.point, ub, uc, f)
+            }
+            _ => {
+                let [uc, _, ub] = weights_of(&res);
+                let f = rotate_feature(res.feature, [F::VertexC, F::VertexA, F::VertexB]);
+                tri(res.point, ub, uc, f)
+            }
+        };
+        let mut features = Vec::new();
+        for _ in 0..20_000 {
+            let p: [f64; 15] = std::array::from_fn(|_| r());
+            let v = |i: usize| DVec3::new(p[i], p[i + 1], p[i + 2]);
+            let (a, b, c) = (v(0), v(3), v(6));
+            let x = if p[9] < 0.0 {
+                // Near the triangle: inside its prism at times.
+                a + (b - a) * (0.5 + 0.7 * p[10]) + (c - a) * (0.5 + 0.7 * p[11]) + v(12) * 0.1
+            } else {
+                v(12) * 3.0
+            };
+            let bits = |t: &TriangleClosest| {
+                (
+                    [t.point.x, t.point.y, t.point.z, t.s, t.t].map(f64::to_bits),
+                    t.feature,
+                )
+            };
+            let got1 = closest_from_largest_angle::<1>(x, b, c, a);
+            let want1 = closest_from_largest_angle::<0>(x, b, c, a).map(|t| rename(t, 1));
+            assert_eq!(got1.map(|t| bits(&t)), want1.map(|t| bits(&t)));
+            let got2 = closest_from_largest_angle::<2>(x, c, a, b);
+            let want2 = closest_from_largest_angle::<0>(x, c, a, b).map(|t| rename(t, 2));
+            assert_eq!(got2.map(|t| bits(&t)), want2.map(|t| bits(&t)));
+            if let Some(t) = got1.filter(|t| !features.contains(&t.feature)) {
+                features.push(t.feature);
+            }
+        }
+        assert_eq!(features.len(), 7, "features met: {features:?}");
     }
 
     fn brute_triangle(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {

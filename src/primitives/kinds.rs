@@ -315,6 +315,12 @@ impl Triangle {
         (cl, v, v.length())
     }
 
+    /// Its weight at its vertex `i` (0, 1, 2 for `a`, `b`, `c`).
+    #[inline]
+    fn corner(&self, i: usize) -> weights::TriCorner {
+        weights::triangle_corner(self.row, self.vmax, self.emax, i)
+    }
+
     /// The edges `b - a` and `c - a` (the barycentric gradients' basis).
     #[inline]
     fn e1(&self) -> DVec3 {
@@ -343,14 +349,25 @@ impl Primitive for Triangle {
     #[inline]
     fn value(&self, x: DVec3, scale: &WeightScale) -> (f64, f64) {
         let cl = self.closest(x);
-        let mut buf = [0.0; 13];
-        let k = weights::triangle_k(self.row, self.vmax, self.emax, &mut buf);
-        let raw = weights::triangle_w_value(cl.s, cl.t, k);
+        let raw = match cl.feature.corner() {
+            Some(i) => self.corner(i).value,
+            None => {
+                let mut buf = [0.0; 13];
+                let k = weights::triangle_k(self.row, self.vmax, self.emax, &mut buf);
+                weights::triangle_w_value(cl.s, cl.t, k)
+            }
+        };
         ((x - cl.point).length(), scale.weight(raw))
     }
     #[inline]
     fn value_slope(&self, x: DVec3, u: DVec3, scale: &WeightScale) -> (f64, f64, f64, f64) {
         let (cl, v, d) = self.offset(x);
+        if let Some(i) = cl.feature.corner() {
+            // Both barycentric gradients are zero at a vertex: so is the log-weight's
+            // slope (the general path gives a zero of either sign there).
+            let w = scale.apply(self.corner(i).value).0;
+            return (d, w, slope(v, d, u), 0.0);
+        }
         let mut buf = [0.0; 13];
         let k = weights::triangle_k(self.row, self.vmax, self.emax, &mut buf);
         let (gs, gt) = weights::triangle_bary_gradients(cl.feature, self.e1(), self.e2());
@@ -358,9 +375,37 @@ impl Primitive for Triangle {
         let (w, dw) = scale.apply(raw);
         (d, w, slope(v, d, u), dw * draw / w)
     }
-    #[inline]
+    /// Inlined where the sink takes the term (most terms are at a vertex: their term
+    /// stays in registers), the rest of the weight out of line.
+    #[inline(always)]
     fn term(&self, x: DVec3, scale: &WeightScale) -> Term {
         let (cl, v, d) = self.offset(x);
+        if let Some(i) = cl.feature.corner() {
+            // The weight at a vertex, tabulated (`weights::TriCorner`): the general
+            // path's results to the last bit, without its polynomial.
+            let c = self.corner(i);
+            let (w, dw) = scale.apply(c.raw);
+            return Term {
+                d,
+                dir: unit_or_zero(v, d),
+                w,
+                grad_w: if dw != 0.0 { dw * c.zero } else { DVec3::ZERO },
+            };
+        }
+        self.term_on_edge_or_face(&cl, v, d, scale)
+    }
+}
+
+impl Triangle {
+    /// [`Primitive::term`] where the closest point is not a vertex.
+    #[inline(never)]
+    fn term_on_edge_or_face(
+        &self,
+        cl: &TriangleClosest,
+        v: DVec3,
+        d: f64,
+        scale: &WeightScale,
+    ) -> Term {
         let mut buf = [0.0; 13];
         let k = weights::triangle_k(self.row, self.vmax, self.emax, &mut buf);
         let (raw, ws, wt) = weights::triangle_w_grad(cl.s, cl.t, k);
@@ -422,6 +467,94 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A term, a value and a value with slopes by the general formulas (the polynomial
+    /// at the closest point's barycentrics, whatever its feature): what the vertices'
+    /// tabulated weights (`weights::TriCorner`) must give.
+    fn general(
+        tri: &Triangle,
+        x: DVec3,
+        u: DVec3,
+        scale: &WeightScale,
+    ) -> (Term, (f64, f64), Slope) {
+        let (cl, v, d) = tri.offset(x);
+        let k = weights::triangle_coefficients(tri.vmax as f64, tri.emax as f64);
+        let (raw, ws, wt) = weights::triangle_w_grad(cl.s, cl.t, &k);
+        let (w, dw) = scale.apply(raw);
+        let (gs, gt) = weights::triangle_bary_gradients(cl.feature, tri.e1(), tri.e2());
+        let grad_w = if dw != 0.0 {
+            dw * (ws * gs + wt * gt)
+        } else {
+            DVec3::ZERO
+        };
+        let term = Term {
+            d,
+            dir: unit_or_zero(v, d),
+            w,
+            grad_w,
+        };
+        let value = (d, scale.weight(weights::triangle_w_value(cl.s, cl.t, &k)));
+        let (raw, draw) = weights::triangle_w_directional(cl.s, cl.t, gs.dot(u), gt.dot(u), &k);
+        let (w, dw) = scale.apply(raw);
+        (term, value, (d, w, slope(v, d, u), dw * draw / w))
+    }
+
+    /// A triangle's terms, values and slopes equal the general formulas' to the last bit
+    /// (the log-weight's slope up to the sign of a zero, which the sink reads as zero),
+    /// at vertices (tabulated weights), edges and faces, for tabulated and untabulated
+    /// valences, isolated triangles and every attenuation branch.
+    #[test]
+    fn vertex_weights_give_the_general_results() {
+        let mut r = rng(0x9e37_79b9_7f4a_7c15);
+        let mut corners = 0;
+        for (i, scale) in scales().take(900).enumerate() {
+            let mut v = || Vec3::new(r() as f32, r() as f32, r() as f32);
+            let (a, b, c) = (v(), v(), v());
+            let (vmax, emax) = [
+                (6.0, 2.0),
+                (1.0, 1.0),
+                (32.0, 8.0),
+                (40.0, 3.0),
+                (5.0, 12.0),
+            ][i % 5];
+            let tri = Triangle::new(a, b, c, vmax, emax);
+            for q in 0..12 {
+                let x = match q {
+                    0 => a.as_dvec3(),
+                    1 => b.as_dvec3(),
+                    _ => DVec3::new(r(), r(), r()) * (0.5 + q as f64),
+                };
+                let u = DVec3::new(r(), r(), r()).normalize();
+                let (term, value, slopes) = general(&tri, x, u, &scale);
+                let bits = |t: &Term| {
+                    [
+                        t.d, t.dir.x, t.dir.y, t.dir.z, t.w, t.grad_w.x, t.grad_w.y, t.grad_w.z,
+                    ]
+                    .map(f64::to_bits)
+                };
+                assert_eq!(bits(&tri.term(x, &scale)), bits(&term), "term {i} {q}");
+                let got = tri.value(x, &scale);
+                assert_eq!(
+                    [got.0, got.1].map(f64::to_bits),
+                    [value.0, value.1].map(f64::to_bits)
+                );
+                let got = tri.value_slope(x, u, &scale);
+                assert_eq!(
+                    [got.0, got.1, got.2].map(f64::to_bits),
+                    [slopes.0, slopes.1, slopes.2].map(f64::to_bits),
+                    "value_slope {i} {q}"
+                );
+                assert!(
+                    got.3 == slopes.3,
+                    "log-weight slope {} against {}",
+                    got.3,
+                    slopes.3
+                );
+                corners += usize::from(tri.closest(x).feature.corner().is_some());
+            }
+        }
+        assert!(corners > 3000, "{corners} vertex terms");
     }
 
     /// `value_slope` agrees with `term`: the distance's slope is `dir . u` and the

@@ -144,23 +144,84 @@ pub fn triangle_table_row(vmax: f32, emax: f32) -> u16 {
 /// [`triangle_table_row`] of valences outside the table.
 pub const NOT_TABULATED: u16 = u16::MAX;
 
+/// The barycentrics `(s, t)` of a triangle's corners `a`, `b`, `c` (0, 1, 2).
+pub const TRI_CORNERS: [(f64, f64); 3] = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)];
+
+/// The triangle weight at one of its corners, as the general formulas give it there
+/// (what a term whose closest point is a vertex needs; most are, for a query a few
+/// triangles away): tabulated with the coefficients, so that such a term evaluates no
+/// polynomial and its results are the general path's to the last bit.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TriCorner {
+    /// [`triangle_w_grad`]'s `W` there.
+    pub raw: f64,
+    /// `ws * 0 + wt * 0` (per component, `ws`, `wt` its partials there): what the
+    /// weight gradient's sum `ws grad s + wt grad t` is at a vertex, where both
+    /// barycentric gradients are zero (its zeros' signs included).
+    pub zero: DVec3,
+    /// [`triangle_w_value`] there (the value paths sum the polynomial in another order,
+    /// so it may round differently; [`triangle_w_directional`]'s `W` is the same sum).
+    pub value: f64,
+}
+
+impl TriCorner {
+    /// Corner `i` (0, 1, 2 for `a`, `b`, `c`) of the weight with coefficients `k`.
+    pub fn of(k: &[f64; 13], i: usize) -> TriCorner {
+        let (s, t) = TRI_CORNERS[i];
+        let (raw, ws, wt) = triangle_w_grad(s, t, k);
+        TriCorner {
+            raw,
+            zero: ws * DVec3::ZERO + wt * DVec3::ZERO,
+            value: triangle_w_value(s, t, k),
+        }
+    }
+}
+
+/// A row of the coefficient table: `k` and its three corners.
+struct TriRow {
+    k: [f64; 13],
+    corners: [TriCorner; 3],
+}
+
+/// The table of the common valences' coefficients, computed once.
+#[inline]
+fn triangle_table() -> &'static [TriRow] {
+    static TABLE: std::sync::OnceLock<Vec<TriRow>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        (1..=TABLE_VMAX)
+            .flat_map(|v| {
+                (1..=TABLE_EMAX).map(move |e| {
+                    let k = triangle_coefficients(v as f64, e as f64);
+                    TriRow {
+                        k,
+                        corners: std::array::from_fn(|i| TriCorner::of(&k, i)),
+                    }
+                })
+            })
+            .collect()
+    })
+}
+
 /// [`triangle_coefficients`] for valences `vmax`, `emax` whose [`triangle_table_row`] is
 /// `row`: from a table computed once for the common valences, else into `buf`.
 #[inline]
 pub fn triangle_k(row: u16, vmax: f32, emax: f32, buf: &mut [f64; 13]) -> &[f64; 13] {
-    static TABLE: std::sync::OnceLock<Vec<[f64; 13]>> = std::sync::OnceLock::new();
     if row != NOT_TABULATED {
-        let table = TABLE.get_or_init(|| {
-            (1..=TABLE_VMAX)
-                .flat_map(|v| {
-                    (1..=TABLE_EMAX).map(move |e| triangle_coefficients(v as f64, e as f64))
-                })
-                .collect()
-        });
-        &table[row as usize]
+        &triangle_table()[row as usize].k
     } else {
         *buf = triangle_coefficients(vmax as f64, emax as f64);
         buf
+    }
+}
+
+/// [`TriCorner::of`] corner `i` of the weight of valences `vmax`, `emax` (table row
+/// `row`, as [`triangle_k`]).
+#[inline]
+pub fn triangle_corner(row: u16, vmax: f32, emax: f32, i: usize) -> TriCorner {
+    if row != NOT_TABULATED {
+        triangle_table()[row as usize].corners[i]
+    } else {
+        TriCorner::of(&triangle_coefficients(vmax as f64, emax as f64), i)
     }
 }
 
@@ -320,27 +381,40 @@ pub fn edge_w<T: Real>(t: T, c: [T; 4]) -> (T, T) {
 
 /// Attenuated, clamped weight of one primitive: `w = (max_adj * clamp(W))^q` and the
 /// factor `dw/dW` (zero where the clamp is active), from the raw polynomial value.
+/// Made by [`WeightScale::new`] (which also computes `max_adj^q`; the fields are read,
+/// not changed, after it).
 #[derive(Clone, Copy, Debug)]
 pub struct WeightScale {
     /// Largest valence of the primitive set (SPEC 1).
     pub max_adj: f64,
     /// Attenuation exponent `q = min(alpha / max_alpha, 1)` (SPEC 5).
     pub q: f64,
+    /// `max_adj^q` ([`WeightScale::max_weight`]), once: every leaf of a walk may need
+    /// it (a weight clamped from above), and the compiler hoists its `powf` out of a
+    /// leaf's loop, so it was computed once per leaf.
+    w_max: f64,
+    /// `1 / max_adj`, the floor of `W`, once (not a division per term).
+    lo: f64,
 }
 
 impl WeightScale {
     pub fn new(max_adj: f64, alpha: f64, max_alpha: f64) -> WeightScale {
-        WeightScale {
-            max_adj: max_adj.max(1.0),
+        let max_adj = max_adj.max(1.0);
+        let mut scale = WeightScale {
+            max_adj,
             q: (alpha / max_alpha).min(1.0),
-        }
+            w_max: 0.0,
+            lo: 1.0 / max_adj,
+        };
+        scale.w_max = scale.pow(scale.max_adj);
+        scale
     }
 
     /// The largest weight any primitive of the set can have, `max_adj^q`: the weight of
     /// a Barnes-Hut far-field term (SPEC 6).
     #[inline]
     pub fn max_weight(&self) -> f64 {
-        self.pow(self.max_adj)
+        self.w_max
     }
 
     #[inline]
@@ -357,7 +431,7 @@ impl WeightScale {
     /// `w` alone for the raw polynomial value `raw` (same as `apply(raw).0`).
     #[inline]
     pub fn weight(&self, raw: f64) -> f64 {
-        if raw <= 1.0 / self.max_adj {
+        if raw <= self.lo {
             1.0
         } else if raw >= 1.0 || raw.is_nan() {
             self.max_weight()
@@ -369,8 +443,7 @@ impl WeightScale {
     /// `(w, dw/dW)` for the raw polynomial value `raw`.
     #[inline]
     pub fn apply(&self, raw: f64) -> (f64, f64) {
-        let lo = 1.0 / self.max_adj;
-        if raw <= lo {
+        if raw <= self.lo {
             (1.0, 0.0)
         } else if raw >= 1.0 || raw.is_nan() {
             (self.max_weight(), 0.0)
@@ -588,6 +661,25 @@ mod tests {
             assert!(d0.abs() < 1e-12 && d1.abs() < 1e-12);
         }
         assert_eq!(edge_quartic(1.0, 1.0), [1.0, 0.0, 0.0, 0.0]);
+    }
+
+    /// `max_weight` (computed once by `new`) is `max_adj^q` on each of `pow`'s branches.
+    #[test]
+    fn max_weight_is_max_adj_to_the_q() {
+        for (max_adj, alpha, max_alpha) in [(12.0, 5.0, 5.0), (12.0, 1.0, 2.0), (7.0, 3.0, 10.0)] {
+            let ws = WeightScale::new(max_adj, alpha, max_alpha);
+            let want = match ws.q {
+                1.0 => max_adj,
+                0.5 => max_adj.sqrt(),
+                q => max_adj.powf(q),
+            };
+            assert_eq!(
+                ws.max_weight().to_bits(),
+                want.to_bits(),
+                "{max_adj} {alpha}"
+            );
+            assert_eq!(ws.apply(2.0).0, want);
+        }
     }
 
     #[test]
