@@ -1,9 +1,10 @@
 //! The image loop: samples traced in parallel by tiles of `TILE x TILE` pixels (each
-//! marched as a cone first, `cone`; the heaviest tiles first, `schedule`), shaded with the hit object's MatCap (SPEC 8) using
-//! the camera-space normal and the object's colours (`albedo::shade_hit`), accumulated
-//! by the film (`crate::film`). A tile's work does not depend on the other tiles, so the
-//! image does not depend on the thread count, and a crop traces the whole image's tiles
-//! that overlap it, so its pixels are those of the whole render.
+//! marched as a cone first, `cone`; the heaviest tiles first, `schedule`), shaded with
+//! the hit object's MatCap (SPEC 8) using the camera-space normal and the object's
+//! colours (`albedo::shade_hit`), accumulated by the film (`crate::film`). A tile's
+//! work does not depend on the other tiles, so the image does not depend on the thread
+//! count or the order, and a crop traces the whole image's tiles that overlap it, so
+//! its pixels are those of the whole render.
 //!
 //! - Uniform anti-aliasing: one `trace_tile` pass per position of the sample pattern
 //!   (the same offset in every pixel, so the tile's cone holds).
