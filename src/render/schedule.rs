@@ -5,8 +5,9 @@
 //! view where the object covers a few tiles, those tiles hold nearly all the work (every
 //! hit ray and the near misses around it), and when one of them is the last to start,
 //! the other threads sit idle for most of a tile: on the published full bunny at 480x270
-//! (20-odd of 510 tiles hold its hit rays) two threads took 0.27 s for 0.48 s of
-//! one-thread work.
+//! (24 of 510 tiles hold 99% of its leaves) two threads took 0.265 s for 0.476 s of
+//! one-thread work in image order, 0.234 s in this one (doc/performance-log.md, round
+//! twenty-five).
 //!
 //! Longest processing time first (Graham's list scheduling: each thread takes the next
 //! tile of a shared queue, the heaviest first) leaves at most the last tile's time idle,
@@ -15,8 +16,9 @@
 //! with about `1 / BOXES_PER_SET` of its primitives each are projected onto the image
 //! (the rectangle around their corners' projections, `Camera::project`), and a tile
 //! weighs the number of boxes whose rectangle overlaps it. A box with a corner behind
-//! the camera (or on its plane) counts on every tile: it can project anywhere. Ties keep the image order.
-//! The estimate only orders the work; a wrong one costs time, never a different image.
+//! the camera (or on its plane) counts on every tile: it can project anywhere. Ties keep
+//! the image order. The estimate only orders the work; a wrong one costs time, never a
+//! different image.
 
 use super::cone::Tile;
 use super::object::TraceObject;
