@@ -301,9 +301,9 @@ pub fn render_film(
         threads: rayon::current_num_threads(),
         ..Default::default()
     };
-    let mut film = RegionFilm::new(region);
     let (s0, _) = tracer.field(camera.origin(), &mut Default::default());
     if s0 <= 0.0 {
+        let film = RegionFilm::empty(region);
         stats.camera_inside = true;
         stats.rays = stats.pixels;
         stats.misses = stats.pixels;
@@ -350,13 +350,13 @@ pub fn render_film(
     let mut centres = adaptive.then(|| NeighbourView::new(traced));
     for r in &results {
         stats.merge(&r.stats);
-        for (i, (px, py)) in r.tile_pixels().enumerate() {
-            if let Some(c) = &mut centres {
+        if let Some(c) = &mut centres {
+            for (i, (px, py)) in r.tile_pixels().enumerate() {
                 c.put(px, py, r.accum[i].first(), &r.records[i]);
             }
-            film.put(px, py, r.accum[i], r.records[i]);
         }
     }
+    let mut film = RegionFilm::from_tiles(region, &results);
     if let Some(centres) = centres {
         let flagged: Vec<(u32, u32)> = (region.y0..region.y1)
             .flat_map(|y| (region.x0..region.x1).map(move |x| (x, y)))
@@ -631,7 +631,8 @@ struct RegionFilm {
 }
 
 impl RegionFilm {
-    fn new(rect: Rect) -> RegionFilm {
+    /// A region where no ray was traced.
+    fn empty(rect: Rect) -> RegionFilm {
         let n = rect.area();
         RegionFilm {
             rect,
@@ -640,11 +641,40 @@ impl RegionFilm {
         }
     }
 
-    /// Keeps a traced pixel if it is in the region.
-    fn put(&mut self, x: u32, y: u32, accum: PixelAccum, record: PixelRecord) {
-        if let Some(i) = self.rect.index(x, y) {
-            self.accum[i] = accum;
-            self.records[i] = record;
+    /// The region's pixels from the traced tiles (`tiles_over` the region, in their
+    /// order: every pixel of the region lies in one), assembled in parallel: the
+    /// buffers' pages are first written there, by all threads (at 1920x1080 filling
+    /// them one thread after the trace took 65 ms of a 0.5 s render).
+    fn from_tiles(rect: Rect, tiles: &[TileResult]) -> RegionFilm {
+        let (tx0, ty0) = tiles.first().map_or((0, 0), |t| (t.tile.x0, t.tile.y0));
+        let columns = tiles.iter().filter(|t| t.tile.y0 == ty0).count().max(1);
+        let w = rect.width() as usize;
+        // The tile holding pixel `i` of the region, and the pixel's index in it.
+        let locate = |i: usize| {
+            let (x, y) = (rect.x0 + (i % w) as u32, rect.y0 + (i / w) as u32);
+            let k = ((y - ty0) / TILE) as usize * columns + ((x - tx0) / TILE) as usize;
+            let t = &tiles[k];
+            debug_assert!(t.tile.x0 <= x && x < t.tile.x0 + t.tile.w);
+            debug_assert!(t.tile.y0 <= y && y < t.tile.y0 + t.tile.h);
+            (t, ((y - t.tile.y0) * t.tile.w + (x - t.tile.x0)) as usize)
+        };
+        let n = rect.area();
+        RegionFilm {
+            rect,
+            accum: (0..n)
+                .into_par_iter()
+                .map(|i| {
+                    let (t, j) = locate(i);
+                    t.accum[j]
+                })
+                .collect(),
+            records: (0..n)
+                .into_par_iter()
+                .map(|i| {
+                    let (t, j) = locate(i);
+                    t.records[j]
+                })
+                .collect(),
         }
     }
 
