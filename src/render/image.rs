@@ -356,7 +356,7 @@ pub fn render_film(
             }
         }
     }
-    let mut film = RegionFilm::from_tiles(region, &results);
+    let mut film = RegionFilm::from_tiles(region, &results, tiles_per_row as usize);
     if let Some(centres) = centres {
         let flagged: Vec<(u32, u32)> = (region.y0..region.y1)
             .flat_map(|y| (region.x0..region.x1).map(move |x| (x, y)))
@@ -642,12 +642,12 @@ impl RegionFilm {
     }
 
     /// The region's pixels from the traced tiles (`tiles_over` the region, in their
-    /// order: every pixel of the region lies in one), assembled in parallel: the
+    /// order, `columns` to a row: every pixel of the region lies in one), assembled in
+    /// parallel: the
     /// buffers' pages are first written there, by all threads (at 1920x1080 filling
     /// them one thread after the trace took 65 ms of a 0.5 s render).
-    fn from_tiles(rect: Rect, tiles: &[TileResult]) -> RegionFilm {
+    fn from_tiles(rect: Rect, tiles: &[TileResult], columns: usize) -> RegionFilm {
         let (tx0, ty0) = tiles.first().map_or((0, 0), |t| (t.tile.x0, t.tile.y0));
-        let columns = tiles.iter().filter(|t| t.tile.y0 == ty0).count().max(1);
         let w = rect.width() as usize;
         // The tile holding pixel `i` of the region, and the pixel's index in it.
         let locate = |i: usize| {
