@@ -36,7 +36,11 @@
 //!    decides the hit. The bound value that falls through is still a safe step
 //!    when it is above epsilon (no full value there could hit), and it is taken: on
 //!    edges and triangles the coarse sum is nearly exact, and a full evaluation at the
-//!    same point would only repeat it. The gap between that bound value and the full
+//!    same point would only repeat it. On edges and triangles the full value that
+//!    follows a bound that fell through is taken at the hit beta, with the gradient
+//!    (item 9): at the scene's beta it is several epsilons low near their surfaces and
+//!    only takes a step the next, finer evaluation repeats (doc/performance-log.md,
+//!    round twenty-six). The gap between that bound value and the full
 //!    value that follows is kept: a later bound step is taken only where the full value
 //!    minus the gap clears twice the threshold (near a soft point cloud the coarse sum
 //!    is several epsilons low, and a bound step there would only fall through again).
@@ -501,8 +505,12 @@ impl<'a> Tracer<'a> {
                     continue;
                 }
                 // A coarse value already within the hit band is usually a hit (where
-                // the coarse sum is loose it is far below zero instead).
-                if c.s.abs() <= eps {
+                // the coarse sum is loose it is far below zero instead). On edges and
+                // triangles (`sticky`) the full value after any bound that fell through
+                // is taken at the hit beta, with the gradient: at the scene's beta it is
+                // several epsilons low there, and only takes a step that the next
+                // evaluation, at the hit beta, has to repeat (item 9).
+                if c.s.abs() <= eps || self.sticky {
                     want = Want::Gradient;
                 }
                 coarse_at = Some(c.s);
