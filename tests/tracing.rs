@@ -246,6 +246,41 @@ fn reach_steps_find_the_surface_plain_steps_find() {
     }
 }
 
+/// Steps aimed at the crossing of the field's tangent (`render::tracer` item 12) land
+/// on the surface that certified steps find, against the exact sum's, and spare work on
+/// the rays that hit: fewer leaves per hit ray on every soft point cloud.
+#[test]
+fn aimed_steps_find_the_surface_certified_steps_find() {
+    let certified = |o| TracerOptions { aim: false, ..o };
+    for name in point_scenes() {
+        let (aimed, plain, a, b) = against_exact(&scene(name, 240, 135), certified);
+        eprintln!("{name}: vs exact, aimed {a:?}\n   certified {b:?}");
+        assert!(
+            a.only_one <= b.only_one + aimed.stats.rays as usize / 500,
+            "{name}: {} rays hit in only one of the aimed and exact renders, {} certified",
+            a.only_one,
+            b.only_one
+        );
+        assert!(
+            a.p50.unwrap() <= b.p50.unwrap() + 0.5 && a.p99.unwrap() <= b.p99.unwrap() + 1.0,
+            "{name}: depth error against the exact surface, aimed {a:?} vs certified {b:?}"
+        );
+        eprintln!(
+            "{name}: leaves per hit ray {:.1} -> {:.1}, full evaluations {:.2} -> {:.2}",
+            plain.stats.leaves_per_hit(),
+            aimed.stats.leaves_per_hit(),
+            plain.stats.evals_per_hit(),
+            aimed.stats.evals_per_hit()
+        );
+        assert!(
+            aimed.stats.leaves_per_hit() < plain.stats.leaves_per_hit(),
+            "{name}: {:.1} vs {:.1} leaves per hit ray",
+            aimed.stats.leaves_per_hit(),
+            plain.stats.leaves_per_hit()
+        );
+    }
+}
+
 /// A tile's step beta switched to the hit beta where its refinements find the coarse
 /// steps lagging by an epsilon or more (`render::step_beta`): as close to the exact
 /// surface as steps at the fixed step beta, and on the soft point clouds (the sphere of

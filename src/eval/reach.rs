@@ -93,6 +93,16 @@ impl Slopes {
         r
     }
 
+    /// The derivative of the smooth distance along `u` at the evaluation point: the
+    /// terms' slopes averaged with their shifted masses as weights (`ds/dL = sum_j e_j
+    /// a_j / sum_j e_j`; pruned subtrees, whose slopes are unknown, left out). `None`
+    /// without terms.
+    pub fn mean_slope(&self) -> Option<f64> {
+        let mass: f64 = self.mass.iter().sum();
+        let moment: f64 = self.moment.iter().sum();
+        (mass > 0.0 && mass.is_finite()).then(|| moment / mass)
+    }
+
     /// The chord coefficients `c_k` of the bin edges `a_k = -1 + k WIDTH`, with the
     /// pruned mass `pruned` at slope -1.
     fn edge_weights(&self, pruned: f64) -> [f64; BINS + 1] {

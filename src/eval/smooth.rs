@@ -98,6 +98,9 @@ pub struct Sample {
     /// Free distance backwards, on `x - [0, reach_back] u`, when asked for by
     /// [`Along::back`] and `s` is below it (at most that length); `s` otherwise.
     pub reach_back: f64,
+    /// The derivative of `s` along the direction given to [`evaluate_reach`]
+    /// (`eval::reach`, `Slopes::mean_slope`); `None` without one.
+    pub slope: Option<f64>,
     pub stats: EvalStats,
     /// With `EvalParams::upper_bound`, an upper bound of the exact smooth distance
     /// (far-field terms at the lower bound of their subtrees, pruned ones at zero; point
@@ -253,6 +256,7 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
         underflow,
         reach,
         reach_back,
+        slope: if SLOPE { slopes.mean_slope() } else { None },
         stats,
         s_upper,
     }

@@ -75,6 +75,9 @@ pub struct TracerOptions {
     /// the hit beta until it is (`render::tracer` item 11): the surface of the exact sum
     /// at the price of fine evaluations where the far field is loose (soft fields).
     pub certified_hits: bool,
+    /// Steps near the surface of soft point clouds are aimed at the crossing of the
+    /// field's tangent along the ray (`render::tracer` item 12).
+    pub aim: bool,
 }
 
 /// How a step that overshoots into the negative band is resolved.
@@ -109,6 +112,7 @@ impl TracerOptions {
             backtrack: Backtrack::Illinois,
             final_step: true,
             certified_hits: false,
+            aim: true,
         }
     }
 
@@ -131,6 +135,7 @@ impl TracerOptions {
             clip: false,
             backtrack: Backtrack::FixedStep,
             final_step: false,
+            aim: false,
             ..TracerOptions::new(epsilon, max_steps)
         }
     }

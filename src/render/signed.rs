@@ -61,6 +61,7 @@ impl SignedSurface {
             underflow: false,
             reach: s,
             reach_back: s,
+            slope: None,
             // The distance is exact: nothing to certify (`render::tracer` item 11).
             s_upper: s,
             stats: EvalStats {

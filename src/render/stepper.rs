@@ -40,6 +40,8 @@ pub(super) struct Stepper {
     last: Option<(f64, f64, Kind)>,
     /// The last step was longer than its sample's value.
     relaxed: bool,
+    /// The last step was aimed at the crossing (`Stepper::aim`).
+    pub(super) aimed: bool,
 }
 
 /// Share of the overlap limit `2 s / (1 + k)` a relaxed step takes.
@@ -53,6 +55,7 @@ impl Stepper {
             slope_known: false,
             last: None,
             relaxed: false,
+            aimed: false,
         }
     }
 
@@ -80,10 +83,20 @@ impl Stepper {
             return None;
         }
         self.relaxed = false;
+        self.aimed = false;
         self.slope = 1.0;
         self.slope_known = false;
         self.last = None;
         Some(tp + sp)
+    }
+
+    /// Lengthens the step just returned by [`Stepper::step`] to `len`, aimed at where the
+    /// field's tangent along the ray crosses zero (`render::tracer` item 12): past the
+    /// sample's free distance `reach` it is a relaxed step, whose gap the next sample
+    /// must close as any other (or land in the hit band).
+    pub(super) fn aim(&mut self, len: f64, reach: f64) {
+        self.relaxed = len > reach;
+        self.aimed = true;
     }
 
     /// The step just returned by [`Stepper::step`] was lengthened to a point certified
@@ -114,6 +127,7 @@ impl Stepper {
             self.slope_known = false;
         }
         self.last = Some((t, s, kind));
+        self.aimed = false;
         let factor = if self.on {
             (RELAX_MARGIN * 2.0 / (1.0 + self.slope)).max(1.0)
         } else {

@@ -28,6 +28,9 @@ pub(in crate::render) struct FieldSample {
     pub(super) reach: f64,
     /// Free distance back along the ray (`s` when not asked for, or not shorter).
     pub(super) reach_back: f64,
+    /// The derivative of `s` along the ray (`eval::reach`), when free distances were
+    /// asked for.
+    pub(super) slope: Option<f64>,
     /// How far the winning object's exact value may lie above `s` (its certified upper
     /// bound minus `s`, `eval::smooth`); 0 for objects whose hits keep the scene's beta
     /// (point clouds), whose far terms the bound does not cover.
@@ -196,6 +199,7 @@ impl<'a> Tracer<'a> {
             grad: None,
             reach: f64::INFINITY,
             reach_back: f64::INFINITY,
+            slope: None,
             gap: 0.0,
         };
         // With several objects a step is the smallest value (no free distance).
@@ -266,6 +270,7 @@ impl<'a> Tracer<'a> {
                     grad: (grad && own_alpha).then_some(sample.grad),
                     reach: free(sample.reach),
                     reach_back: free(sample.reach_back),
+                    slope: sample.slope.filter(|_| own_alpha),
                     gap: if self.hit_beta[k] < obj.params.beta {
                         (sample.s_upper - sample.s).max(0.0)
                     } else {
