@@ -23,8 +23,9 @@ pub(super) const AIM_MAX: f64 = 40.0;
 
 /// where the field falls along the ray at least this fast: a landing in the band at a
 /// fall `k` may lie `epsilon / k` from the crossing along the ray (at 0.1 the 7k bunny's
-/// points had their 99th percentile of depth error 1.2 epsilons farther from the exact
-/// surface; at 0.3 within 0.9, with nearly all the leaves spared),
+/// points had the 99th percentile of their depth error 1.2-1.6 epsilons farther from the
+/// exact surface; at 0.3 within 0.9, nearly all the leaves still spared:
+/// doc/performance-log.md, round twenty-six),
 const AIM_MIN_FALL: f64 = 0.3;
 
 /// and at most this many times as long as the step they replace.

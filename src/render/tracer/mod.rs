@@ -129,7 +129,7 @@
 //!     behind it must close the gap, else the ray goes back, except where it lands in
 //!     the hit band: that is the hit, and at a negative value `s` it is moved back to
 //!     the crossing's first-order estimate (as on edges and triangles, item 4), at most
-//!     `2 |s|` (as far as a final step moves on). On soft point clouds 13-22% fewer
+//!     `2 |s|` (as far as a final step moves on). On soft point clouds 15-18% fewer
 //!     leaves per hit ray, the hits as close to the exact surface within an epsilon at
 //!     the 99th percentile (doc/performance-log.md, round twenty-six). Where the band
 //!     is wide against the kernel (stiff clouds, whose surface is a field of small
