@@ -210,6 +210,24 @@ fn against_exact(
     (on, plain, a, b)
 }
 
+/// Asserts that a render with a device on (depth differences `a` from the exact
+/// surface, `rays` rays) is as close to the exact surface as the one without it (`b`):
+/// at most a ray in 500 more hitting in only one of it and the exact render, the median
+/// and 99th percentile within half an epsilon and one epsilon.
+fn as_close_to_exact(name: &str, (on, off): (&str, &str), a: &DepthDiff, b: &DepthDiff, rays: u64) {
+    eprintln!("{name}: vs exact, {on} {a:?}\n   {off} {b:?}");
+    assert!(
+        a.only_one <= b.only_one + rays as usize / 500,
+        "{name}: {} rays hit in only one of the exact render and the one with {on}, {} with {off}",
+        a.only_one,
+        b.only_one
+    );
+    assert!(
+        a.p50.unwrap() <= b.p50.unwrap() + 0.5 && a.p99.unwrap() <= b.p99.unwrap() + 1.0,
+        "{name}: depth error against the exact surface, {on} {a:?} vs {off} {b:?}"
+    );
+}
+
 #[test]
 fn reach_steps_find_the_surface_plain_steps_find() {
     let names = point_scenes();
@@ -220,16 +238,12 @@ fn reach_steps_find_the_surface_plain_steps_find() {
     for name in names {
         // Both against the exact sum's surface (beta 0, plain steps), in epsilons.
         let (reach, stepped, a, b) = against_exact(&scene(name, 240, 135), plain);
-        eprintln!("{name}: vs exact, reach steps {a:?}\n   plain steps {b:?}");
-        assert!(
-            a.only_one <= b.only_one + reach.stats.rays as usize / 500,
-            "{name}: {} rays hit in only one of the reach and exact renders, {} with plain steps",
-            a.only_one,
-            b.only_one
-        );
-        assert!(
-            a.p50.unwrap() <= b.p50.unwrap() + 0.5 && a.p99.unwrap() <= b.p99.unwrap() + 1.0,
-            "{name}: depth error against the exact surface, reach {a:?} vs plain {b:?}"
+        as_close_to_exact(
+            name,
+            ("reach steps", "plain steps"),
+            &a,
+            &b,
+            reach.stats.rays,
         );
         // The point of it: fewer full evaluations on the rays that hit.
         eprintln!(
@@ -254,16 +268,12 @@ fn aimed_steps_find_the_surface_certified_steps_find() {
     let certified = |o| TracerOptions { aim: false, ..o };
     for name in point_scenes() {
         let (aimed, plain, a, b) = against_exact(&scene(name, 240, 135), certified);
-        eprintln!("{name}: vs exact, aimed {a:?}\n   certified {b:?}");
-        assert!(
-            a.only_one <= b.only_one + aimed.stats.rays as usize / 500,
-            "{name}: {} rays hit in only one of the aimed and exact renders, {} certified",
-            a.only_one,
-            b.only_one
-        );
-        assert!(
-            a.p50.unwrap() <= b.p50.unwrap() + 0.5 && a.p99.unwrap() <= b.p99.unwrap() + 1.0,
-            "{name}: depth error against the exact surface, aimed {a:?} vs certified {b:?}"
+        as_close_to_exact(
+            name,
+            ("aimed steps", "certified steps"),
+            &a,
+            &b,
+            aimed.stats.rays,
         );
         eprintln!(
             "{name}: leaves per hit ray {:.1} -> {:.1}, full evaluations {:.2} -> {:.2}",
