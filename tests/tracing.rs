@@ -367,7 +367,12 @@ fn the_final_step_brings_hits_closer_to_the_exact_surface_never_past_it() {
         let s = scene(name, 120, 68);
         let built = in_pool(2, || build_scene(&s)).unwrap();
         let eps = built.epsilon;
-        let options = TracerOptions::new(eps, s.render.max_steps);
+        // Without aimed steps (tested on their own above): their landings in the band
+        // leave the final step less to do on the point clouds.
+        let options = TracerOptions {
+            aim: false,
+            ..TracerOptions::new(eps, s.render.max_steps)
+        };
         let on = Tracer::new(&built.objects, options);
         let off = Tracer::new(
             &built.objects,

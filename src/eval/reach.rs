@@ -30,6 +30,13 @@
 //! step from the far end (`render::stepper`): near a surface met at an angle the field
 //! grows going back along the ray, so that reach is often several times `s`.
 //!
+//! The same bins give the derivative of `s` along the ray, `sum_j e_j a_j / sum_j e_j`,
+//! and an estimate of its second derivative, `sum_j p_j (1 - a_j^2) / d_j - alpha
+//! Var_p(a)` (`p_j = e_j / sum e`; the distances taken at the nearest one plus a kernel
+//! width, the slopes' spread between the bins): the tracer aims steps on soft point
+//! clouds at the crossing of that expansion (`render::tracer` item 12). Estimates, not
+//! bounds: an aimed step is certified as any relaxed step.
+//!
 //! Where all terms come at slope -1 (the ray heads straight at everything) this gives
 //! back the plain sphere-tracing step `s`; where the terms that matter are met at a
 //! grazing angle, or spread in direction, it certifies much longer steps.
@@ -101,6 +108,26 @@ impl Slopes {
         let mass: f64 = self.mass.iter().sum();
         let moment: f64 = self.moment.iter().sum();
         (mass > 0.0 && mass.is_finite()).then(|| moment / mass)
+    }
+
+    /// An estimate of the second derivative of the smooth distance along `u`, for
+    /// sharpness `alpha` and the terms' typical distance `dist`: `sum_j p_j g_j'' - alpha
+    /// Var_p(a)` with `p_j = e_j / sum e`. Each term's distance bends away from its
+    /// tangent (`g_j'' = (1 - a_j^2) / d_j`, taken at `dist`), the log-sum the other way
+    /// by the slopes' spread (taken between the bins, each bin at its mean slope).
+    /// `None` without terms.
+    pub fn bend(&self, alpha: f64, dist: f64) -> Option<f64> {
+        let mass: f64 = self.mass.iter().sum();
+        let moment: f64 = self.moment.iter().sum();
+        (mass > 0.0 && mass.is_finite() && dist > 0.0).then(|| {
+            let mean = moment / mass;
+            let square: f64 = (0..BINS)
+                .filter(|&k| self.mass[k] > 0.0)
+                .map(|k| self.moment[k] * self.moment[k] / self.mass[k])
+                .sum::<f64>()
+                / mass;
+            (1.0 - square) / dist - alpha * (square - mean * mean).max(0.0)
+        })
     }
 
     /// The chord coefficients `c_k` of the bin edges `a_k = -1 + k WIDTH`, with the

@@ -101,6 +101,9 @@ pub struct Sample {
     /// The derivative of `s` along the direction given to [`evaluate_reach`]
     /// (`eval::reach`, `Slopes::mean_slope`); `None` without one.
     pub slope: Option<f64>,
+    /// An estimate of the second derivative of `s` along that direction
+    /// (`Slopes::bend`); `None` without one.
+    pub bend: Option<f64>,
     pub stats: EvalStats,
     /// With `EvalParams::upper_bound`, an upper bound of the exact smooth distance
     /// (far-field terms at the lower bound of their subtrees, pruned ones at zero; point
@@ -257,6 +260,12 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
         reach,
         reach_back,
         slope: if SLOPE { slopes.mean_slope() } else { None },
+        // The terms that matter lie within a kernel width or so of the nearest.
+        bend: if SLOPE {
+            slopes.bend(p.alpha, acc.m + 1.0 / p.alpha)
+        } else {
+            None
+        },
         stats,
         s_upper,
     }

@@ -62,6 +62,7 @@ impl SignedSurface {
             reach: s,
             reach_back: s,
             slope: None,
+            bend: None,
             // The distance is exact: nothing to certify (`render::tracer` item 11).
             s_upper: s,
             stats: EvalStats {

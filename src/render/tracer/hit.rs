@@ -54,9 +54,11 @@ impl Tracer<'_> {
     }
 
     /// The length of an aimed step from the sample `f` at `t` whose step is `step`, if
-    /// one is taken (item 12): to where the field's tangent along the ray crosses zero,
-    /// `s / k` for the field's fall `k` along the ray, where that is longer than the
-    /// step, at most [`AIM_CAP`] times it, and short of `t_max`.
+    /// one is taken (item 12): to where `s - k L + c L^2 / 2` crosses zero (`k` the
+    /// field's fall along the ray, `c` its bend; `s / k` without a bend), the root
+    /// `2 s / (k + sqrt(k^2 - 2 c s))`, where that is longer than the step, at most
+    /// [`AIM_CAP`] times it, and short of `t_max`; none where the expansion stays above
+    /// zero.
     pub(super) fn aimed_step(
         &self,
         f: &FieldSample,
@@ -67,7 +69,16 @@ impl Tracer<'_> {
             return None;
         }
         let k = -f.slope?;
-        let len = f.s / k;
+        let len = match f.bend {
+            Some(c) => {
+                let disc = k * k - 2.0 * c * f.s;
+                if disc < 0.0 {
+                    return None;
+                }
+                2.0 * f.s / (k + disc.sqrt())
+            }
+            None => f.s / k,
+        };
         (k > AIM_MIN_FALL && len > step && len <= AIM_CAP * step && t + len < t_max).then_some(len)
     }
 

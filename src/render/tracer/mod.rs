@@ -118,18 +118,23 @@
 //! 12. On point clouds whose hit band is narrow against the kernel (`alpha epsilon <
 //!     0.4`, where the pruning tolerance of item 6 is below its cap) a step from a value
 //!     at the hit beta within [`AIM_MAX`](hit::AIM_MAX) epsilons (one at the coarser
-//!     step beta of item 10 is an epsilon or more low) is aimed at the crossing of the
-//!     field's tangent along the ray, `s / k` with `k` the field's fall along the ray
-//!     (the terms' mean slope, `eval::reach`, free with the free distance), where that
-//!     is longer than the step, at most [`AIM_CAP`](hit::AIM_CAP) times it, short of
-//!     the ray's end and `k` at least 0.3; its evaluation carries the gradient. The free
-//!     distance is a bound: from 20 epsilons out it lands an epsilon or two short of the
-//!     surface, and one more evaluation follows; the tangent lands within the band more
-//!     often. The aimed step is a relaxed step (item 8): the next sample's free distance
-//!     behind it must close the gap, else the ray goes back, except where it lands in
-//!     the hit band: that is the hit, and at a negative value `s` it is moved back to
-//!     the crossing's first-order estimate (as on edges and triangles, item 4), at most
-//!     `2 |s|` (as far as a final step moves on). On soft point clouds 15-18% fewer
+//!     step beta of item 10 is an epsilon or more low) is aimed at where the field's
+//!     second-order expansion along the ray crosses zero: `s - k L + c L^2 / 2` with
+//!     `k` the field's fall along the ray (the terms' mean slope) and `c` its bend
+//!     (`Slopes::bend`: the terms' distances bend away from their tangents, the log-sum
+//!     the other way by the spread of their slopes), both from the free distance's bins
+//!     at no cost per term (`eval::reach`). The step is taken where it is longer than
+//!     the step, at most [`AIM_CAP`](hit::AIM_CAP) times it, short of the ray's end and
+//!     `k` at least 0.3 (none where the expansion never reaches zero); its evaluation
+//!     carries the gradient. The free distance is a bound: from 20 epsilons out it lands
+//!     an epsilon or two short of the surface, and one more evaluation follows; the
+//!     tangent alone (`c = 0`) lands in the band more often, and short of it where the
+//!     field bends up (most rays onto a point cloud), the expansion more often still.
+//!     The aimed step is a relaxed step (item 8): the next sample's free distance behind
+//!     it must close the gap, else the ray goes back, except where it lands in the hit
+//!     band: that is the hit, and at a negative value `s` it is moved back to the
+//!     crossing's first-order estimate (as on edges and triangles, item 4), at most `2
+//!     |s|` (as far as a final step moves on). On soft point clouds 22-23% fewer
 //!     leaves per hit ray, the hits as close to the exact surface within an epsilon at
 //!     the 99th percentile (doc/performance-log.md, round twenty-six). Where the band
 //!     is wide against the kernel (stiff clouds, whose surface is a field of small

@@ -31,6 +31,8 @@ pub(in crate::render) struct FieldSample {
     /// The derivative of `s` along the ray (`eval::reach`), when free distances were
     /// asked for.
     pub(super) slope: Option<f64>,
+    /// An estimate of its second derivative along the ray (`eval::reach`), likewise.
+    pub(super) bend: Option<f64>,
     /// How far the winning object's exact value may lie above `s` (its certified upper
     /// bound minus `s`, `eval::smooth`); 0 for objects whose hits keep the scene's beta
     /// (point clouds), whose far terms the bound does not cover.
@@ -200,6 +202,7 @@ impl<'a> Tracer<'a> {
             reach: f64::INFINITY,
             reach_back: f64::INFINITY,
             slope: None,
+            bend: None,
             gap: 0.0,
         };
         // With several objects a step is the smallest value (no free distance).
@@ -271,6 +274,7 @@ impl<'a> Tracer<'a> {
                     reach: free(sample.reach),
                     reach_back: free(sample.reach_back),
                     slope: sample.slope.filter(|_| own_alpha),
+                    bend: sample.bend.filter(|_| own_alpha),
                     gap: if self.hit_beta[k] < obj.params.beta {
                         (sample.s_upper - sample.s).max(0.0)
                     } else {
