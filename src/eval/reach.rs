@@ -100,33 +100,28 @@ impl Slopes {
         r
     }
 
-    /// The derivative of the smooth distance along `u` at the evaluation point: the
-    /// terms' slopes averaged with their shifted masses as weights (`ds/dL = sum_j e_j
-    /// a_j / sum_j e_j`; pruned subtrees, whose slopes are unknown, left out). `None`
-    /// without terms.
-    pub fn mean_slope(&self) -> Option<f64> {
+    /// The first two derivatives of the smooth distance along `u` at the evaluation
+    /// point, for sharpness `alpha` and the terms' typical distance `dist > 0`; `None`
+    /// without terms. The first is exact: the terms' slopes averaged with their shifted
+    /// masses as weights, `ds/dL = sum_j p_j a_j` with `p_j = e_j / sum e` (pruned
+    /// subtrees, whose slopes are unknown, left out). The second is an estimate, `sum_j
+    /// p_j g_j'' - alpha Var_p(a)`: each term's distance bends away from its tangent
+    /// (`g_j'' = (1 - a_j^2) / d_j`, taken at `dist`), the log-sum the other way by the
+    /// slopes' spread (taken between the bins, each bin at its mean slope).
+    pub fn derivatives(&self, alpha: f64, dist: f64) -> Option<(f64, f64)> {
         let mass: f64 = self.mass.iter().sum();
         let moment: f64 = self.moment.iter().sum();
-        (mass > 0.0 && mass.is_finite()).then(|| moment / mass)
-    }
-
-    /// An estimate of the second derivative of the smooth distance along `u`, for
-    /// sharpness `alpha` and the terms' typical distance `dist`: `sum_j p_j g_j'' - alpha
-    /// Var_p(a)` with `p_j = e_j / sum e`. Each term's distance bends away from its
-    /// tangent (`g_j'' = (1 - a_j^2) / d_j`, taken at `dist`), the log-sum the other way
-    /// by the slopes' spread (taken between the bins, each bin at its mean slope).
-    /// `None` without terms.
-    pub fn bend(&self, alpha: f64, dist: f64) -> Option<f64> {
-        let mass: f64 = self.mass.iter().sum();
-        let moment: f64 = self.moment.iter().sum();
-        (mass > 0.0 && mass.is_finite() && dist > 0.0).then(|| {
+        (mass > 0.0 && mass.is_finite()).then(|| {
             let mean = moment / mass;
             let square: f64 = (0..BINS)
                 .filter(|&k| self.mass[k] > 0.0)
                 .map(|k| self.moment[k] * self.moment[k] / self.mass[k])
                 .sum::<f64>()
                 / mass;
-            (1.0 - square) / dist - alpha * (square - mean * mean).max(0.0)
+            (
+                mean,
+                (1.0 - square) / dist - alpha * (square - mean * mean).max(0.0),
+            )
         })
     }
 

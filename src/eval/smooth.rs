@@ -99,10 +99,10 @@ pub struct Sample {
     /// [`Along::back`] and `s` is below it (at most that length); `s` otherwise.
     pub reach_back: f64,
     /// The derivative of `s` along the direction given to [`evaluate_reach`]
-    /// (`eval::reach`, `Slopes::mean_slope`); `None` without one.
+    /// (`eval::reach`, `Slopes::derivatives`); `None` without one.
     pub slope: Option<f64>,
     /// An estimate of the second derivative of `s` along that direction
-    /// (`Slopes::bend`); `None` without one.
+    /// (`Slopes::derivatives`); `None` without one.
     pub bend: Option<f64>,
     pub stats: EvalStats,
     /// With `EvalParams::upper_bound`, an upper bound of the exact smooth distance
@@ -252,6 +252,12 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
     } else {
         s
     };
+    // The terms that matter lie within a kernel width or so of the nearest.
+    let derivatives = if SLOPE {
+        slopes.derivatives(p.alpha, acc.m + 1.0 / p.alpha)
+    } else {
+        None
+    };
     Sample {
         s,
         grad,
@@ -259,13 +265,8 @@ fn evaluate_impl<const GRAD: bool, const SLOPE: bool>(
         underflow,
         reach,
         reach_back,
-        slope: if SLOPE { slopes.mean_slope() } else { None },
-        // The terms that matter lie within a kernel width or so of the nearest.
-        bend: if SLOPE {
-            slopes.bend(p.alpha, acc.m + 1.0 / p.alpha)
-        } else {
-            None
-        },
+        slope: derivatives.map(|(slope, _)| slope),
+        bend: derivatives.map(|(_, bend)| bend),
         stats,
         s_upper,
     }

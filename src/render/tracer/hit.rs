@@ -53,6 +53,21 @@ impl Tracer<'_> {
         self.hit_moved(o, d, (t, floor), f, self.weighted[f.object], stats)
     }
 
+    /// The hit where an aimed step landed in the hit band (item 12): its gap behind is
+    /// not covered, so at a negative value it is moved back to the crossing's estimate,
+    /// at most as far as a final step moves on (`FINAL_REACH |s|`).
+    pub(super) fn landing(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        (t, floor): (f64, f64),
+        f: &FieldSample,
+        stats: &mut RayStats,
+    ) -> Hit {
+        let floor = floor.max(t + FINAL_REACH * f.s.min(0.0));
+        self.hit_moved(o, d, (t, floor), f, true, stats)
+    }
+
     /// The length of an aimed step from the sample `f` at `t` whose step is `step`, if
     /// one is taken (item 12): to where `s - k L + c L^2 / 2` crosses zero (`k` the
     /// field's fall along the ray, `c` its bend; `s / k` without a bend), the root
@@ -85,7 +100,7 @@ impl Tracer<'_> {
     /// [`Tracer::hit`], a hit at a negative value moved back to the crossing's estimate
     /// if `back` (edges and triangles, whose free distances hold to first order; an aimed
     /// step's landing, whose gap is not covered).
-    pub(super) fn hit_moved(
+    fn hit_moved(
         &self,
         o: DVec3,
         d: DVec3,

@@ -121,7 +121,7 @@
 //!     step beta of item 10 is an epsilon or more low) is aimed at where the field's
 //!     second-order expansion along the ray crosses zero: `s - k L + c L^2 / 2` with
 //!     `k` the field's fall along the ray (the terms' mean slope) and `c` its bend
-//!     (`Slopes::bend`: the terms' distances bend away from their tangents, the log-sum
+//!     (`Slopes::derivatives`: the terms' distances bend away from their tangents, the log-sum
 //!     the other way by the spread of their slopes), both from the free distance's bins
 //!     at no cost per term (`eval::reach`). The step is taken where it is longer than
 //!     the step, at most [`AIM_CAP`](hit::AIM_CAP) times it, short of the ray's end and
@@ -599,14 +599,12 @@ impl<'a> Tracer<'a> {
             }
             near = f.s - gap < 2.0 * tau;
             if f.s.abs() <= eps {
-                let mut floor = prev.map_or(t, |p| p.0);
-                let back = landed || self.weighted[f.object];
-                if landed && !self.weighted[f.object] {
-                    // An aimed landing on a point cloud moves back at most as far as a
-                    // final step moves on (item 12).
-                    floor = floor.max(t + hit::FINAL_REACH * f.s);
-                }
-                let hit = self.hit_moved(o, d, (t, floor), &f, back, &mut stats);
+                let floor = prev.map_or(t, |p| p.0);
+                let hit = if landed {
+                    self.landing(o, d, (t, floor), &f, &mut stats)
+                } else {
+                    self.hit(o, d, (t, floor), &f, &mut stats)
+                };
                 return RayResult {
                     hit: Some(hit),
                     stats,
