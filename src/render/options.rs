@@ -78,6 +78,10 @@ pub struct TracerOptions {
     /// Steps near the surface of soft point clouds are aimed at the crossing of the
     /// field's tangent along the ray (`render::tracer` item 12).
     pub aim: bool,
+    /// On soft edge and triangle meshes, a sample a few epsilons above the hit band whose
+    /// final step (`final_step`) is predicted, from its gradient, to end in the band is
+    /// the hit (`render::tracer` item 13). Off, only a sample in the band is.
+    pub band_reach: bool,
 }
 
 /// How a step that overshoots into the negative band is resolved.
@@ -113,6 +117,7 @@ impl TracerOptions {
             final_step: true,
             certified_hits: false,
             aim: true,
+            band_reach: true,
         }
     }
 
@@ -136,6 +141,7 @@ impl TracerOptions {
             backtrack: Backtrack::FixedStep,
             final_step: false,
             aim: false,
+            band_reach: false,
             ..TracerOptions::new(epsilon, max_steps)
         }
     }

@@ -290,11 +290,13 @@ fn run_cell(
     let n = obj.sets.iter().map(|s| s.len()).sum();
     let alpha = obj.params.alpha;
     let label = cell.key();
-    let render = |built: &crate::render::build::BuiltScene, max_steps| {
+    // `strict`: the exact reference takes hits in the band only (`band_reach` off).
+    let render = |built: &crate::render::build::BuiltScene, max_steps, strict: bool| {
         render_objects(
             &built.objects,
             TracerOptions {
                 certified_hits: opts.certified_hits,
+                band_reach: !strict,
                 ..TracerOptions::new(built.epsilon, max_steps)
             },
             &built.camera,
@@ -304,9 +306,9 @@ fn run_cell(
             progress,
         )
     };
-    let mut rendered = render(&built, scene.render.max_steps);
+    let mut rendered = render(&built, scene.render.max_steps, false);
     for _ in 1..opts.repeat {
-        let r = render(&built, scene.render.max_steps);
+        let r = render(&built, scene.render.max_steps, false);
         if r.stats.seconds < rendered.stats.seconds {
             rendered = r;
         }
@@ -332,8 +334,8 @@ fn run_cell(
         Some(es) => {
             let (s_a, b_a) = load(Some(camera), opts.beta, es)?;
             let (s_e, b_e) = load(Some(camera), 0.0, es)?;
-            let a = render(&b_a, s_a.render.max_steps);
-            let e = render(&b_e, s_e.render.max_steps);
+            let a = render(&b_a, s_a.render.max_steps, false);
+            let e = render(&b_e, s_e.render.max_steps, true);
             Some(compare_depths(
                 &a.depth,
                 &e.depth,

@@ -1,22 +1,13 @@
-//! A ray's hit (SPEC 7; `render::tracer` items 4 and 12): where a sample in the hit band
-//! puts it (one more step, free, from a positive value; back to the crossing's
+//! A ray's hit (SPEC 7; `render::tracer` items 4, 12 and 13): where a sample in the hit
+//! band puts it (one more step, free, from a positive value; back to the crossing's
 //! first-order estimate from a negative one where the step that got there was not
-//! certain), and the aimed steps that land samples in the band.
+//! certain), the samples just above the band whose free step is predicted to end in it,
+//! and the aimed steps that land samples in the band.
 
+use super::Tracer;
+use super::ray::{Hit, RayStats};
 use super::sample::FieldSample;
-use super::{RayStats, Tracer};
 use glam::DVec3;
-
-/// A ray's intersection with the zero set.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hit {
-    pub t: f64,
-    pub point: DVec3,
-    /// Unit normal in world space (zero if the gradient vanished).
-    pub normal: DVec3,
-    /// Index of the object whose smooth distance is smallest at the hit.
-    pub object: usize,
-}
 
 /// Aimed steps (module docs, item 12) are taken from values within this many epsilons,
 pub(super) const AIM_MAX: f64 = 40.0;
@@ -38,6 +29,17 @@ pub(super) const AIM_CAP: f64 = 2.0;
 /// (the exact value at the hits for caps of 1, 2 and 4 `s`: doc/performance-log.md,
 /// round twelve).
 pub(super) const FINAL_REACH: f64 = 2.0;
+
+/// A sample at most this many epsilons above the hit band may be the hit (module docs,
+/// item 13),
+pub(super) const BAND_REACH_MAX: f64 = 4.0;
+
+/// where its final step is predicted to end at most this many epsilons above zero
+/// (first order, from the gradient),
+const BAND_REACH_LAND: f64 = 0.25;
+
+/// and the field falls along the ray at least this fast.
+const BAND_REACH_MIN_FALL: f64 = 0.1;
 
 impl Tracer<'_> {
     /// The hit at the sample `f` at `t`; `floor` is a parameter known to lie in front of
@@ -66,6 +68,31 @@ impl Tracer<'_> {
     ) -> Hit {
         let floor = floor.max(t + FINAL_REACH * f.s.min(0.0));
         self.hit_moved(o, d, (t, floor), f, true, stats)
+    }
+
+    /// Whether the sample `f`, above the hit band, is the hit all the same (module docs,
+    /// item 13): on an object that takes such hits, within [`BAND_REACH_MAX`] epsilons,
+    /// with the gradient, where the field falls along the ray at least
+    /// [`BAND_REACH_MIN_FALL`] and its final step (`s`, or the free distance up to
+    /// [`FINAL_REACH`] `s`) ends, to first order, within [`BAND_REACH_LAND`] epsilons
+    /// of zero.
+    pub(super) fn lands_in_band(&self, f: &FieldSample, d: DVec3) -> bool {
+        let eps = self.options.epsilon;
+        if !self.band_reach[f.object] || f.s <= eps || f.s > BAND_REACH_MAX * eps {
+            return false;
+        }
+        let Some(g) = f.grad else {
+            return false;
+        };
+        let Some(bend) = f.bend else {
+            return false;
+        };
+        let k = -g.dot(d);
+        let len = f.reach.max(f.s).min(FINAL_REACH * f.s);
+        // The bend only where it lifts the field: where it lowers it, the first order
+        // alone decides.
+        k >= BAND_REACH_MIN_FALL
+            && f.s - k * len + 0.5 * bend.max(0.0) * len * len <= BAND_REACH_LAND * eps
     }
 
     /// The length of an aimed step from the sample `f` at `t` whose step is `step`, if

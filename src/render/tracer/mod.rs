@@ -143,11 +143,30 @@
 //!     taken; on edges and triangles the weights' change along the ray makes the
 //!     tangent overshoot (more backtracks and rejected steps than evaluations spared, on
 //!     four meshes).
+//! 13. On edges and triangles whose hit band is narrow against the kernel (`alpha
+//!     epsilon < 0.4`, hits at the hit beta), a sample at the hit beta a few epsilons
+//!     above the band (at most [`BAND_REACH_MAX`](hit::BAND_REACH_MAX)), with the
+//!     gradient, is the hit when its final step (item 4: `s`, or the free distance up to
+//!     `2 s`) is predicted to end within a quarter epsilon of zero: `s - k L + max(c, 0)
+//!     L^2 / 2 <= epsilon / 4` for the step `L`, `k >= 0.1` the field's fall along the
+//!     ray (from the gradient) and `c` its bend (item 12's estimate, counted only where
+//!     it lifts the field). The step is the final step's, as certain as it is, so the
+//!     hit stays in front of the surface; only its landing in the band is predicted,
+//!     and the evaluation that would confirm it is spared. Near these surfaces the field
+//!     falls slowly along the ray (`k` of 0.2-0.5) and the free distance lands a few
+//!     epsilons short of the band, so most rays took one more fine evaluation there:
+//!     1-16% fewer full evaluations per hit ray on the soft cells of the speed matrix,
+//!     the hits' 99th percentile depth error against the exact surface a quarter to
+//!     half an epsilon larger (doc/performance-log.md, round twenty-seven). Without the
+//!     bend, a ray skimming a thin tube of the hex torus took a hit where the field
+//!     rises again and the ray passes by. Off in the paper's mode, with certified hits
+//!     (item 11), and in the speed matrix's exact reference (`TracerOptions::band_reach`).
 
 mod hit;
+mod ray;
 mod sample;
 
-pub use hit::Hit;
+pub use ray::{Hit, RayResult, RayStats};
 use sample::MAX_HALVINGS;
 pub(super) use sample::{FieldSample, Want};
 
@@ -156,50 +175,10 @@ use super::object::TraceObject;
 use super::options::{Backtrack, TracerOptions};
 use super::step_beta::StepBeta;
 use super::stepper::{Kind, Stepper};
+use crate::eval::Along;
 use crate::eval::params::MAX_PRUNE_TOLERANCE;
-use crate::eval::{Along, EvalStats};
 use crate::primitives::AnySet;
 use glam::DVec3;
-
-/// Work done for one ray.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RayStats {
-    /// Full-accuracy field evaluations, at the scene's beta (one per object evaluated
-    /// per step; those near the surface carry the gradient the hit is shaded with).
-    pub evals: u32,
-    /// Bound steps: cheaper evaluations at a coarser beta (far from the surface).
-    pub coarse_evals: u32,
-    /// Sum of the evaluations' statistics (leaves, nodes), coarse and full together.
-    pub eval: EvalStats,
-    /// Leaves visited by the coarse evaluations alone (included in `eval`).
-    pub coarse_leaves: u32,
-    /// Full evaluations that only took a step, made at the coarser step beta (point
-    /// clouds, module docs item 10; counted in `evals` too).
-    pub step_evals: u32,
-    /// Retries with a smaller alpha after an infinite (underflowed) naive evaluation.
-    pub falloffs: u32,
-    /// Evaluations spent locating a crossing after overshooting into the negative band.
-    pub backtracks: u32,
-    /// Over-relaxed steps whose gap the next sample did not cover (the ray went back to
-    /// the plain step; the sample's evaluation is counted in `evals`/`coarse_evals`).
-    pub rejected_steps: u32,
-    /// Re-evaluations at the finer hit beta of a sample whose value at the scene's beta
-    /// fell in the hit band or below (counted in `evals` too).
-    pub refinements: u32,
-    /// Times the ray's hit beta was halved because a value in the hit band or below
-    /// had a certified gap above [`GAP_MAX`] epsilons (module docs, item 11; the
-    /// re-evaluations are counted in `evals` and `refinements` too).
-    pub hit_halvings: u32,
-    /// The ray ran out of steps (counted as a miss).
-    pub exhausted: bool,
-}
-
-/// The result of tracing one ray.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RayResult {
-    pub hit: Option<Hit>,
-    pub stats: RayStats,
-}
 
 /// An evaluation is predicted to hit (and carries the gradient) when its predecessor's
 /// value, or the value extrapolated from the last two, is within this many epsilons
@@ -273,6 +252,8 @@ pub struct Tracer<'a> {
     weighted: Vec<bool>,
     /// Per object: its steps near the surface are aimed at the crossing (item 12).
     aims: Vec<bool>,
+    /// Per object: a sample just above the hit band may be the hit (item 13).
+    band_reach: Vec<bool>,
     /// Union of the grown object boxes.
     min: DVec3,
     max: DVec3,
@@ -350,6 +331,23 @@ impl<'a> Tracer<'a> {
                 options.aim && options.reach_steps && points && tol < MAX_PRUNE_TOLERANCE
             })
             .collect();
+        // Hits from above the band (item 13): edges and triangles whose hit band is
+        // narrow against the kernel (the pruning tolerance below its cap), where their
+        // hits are decided at the hit beta (`sticky`).
+        let band_reach = points_only
+            .iter()
+            .zip(&tolerance)
+            .zip(objects.iter().zip(&hit_beta))
+            .map(|((&points, &tol), (o, &h))| {
+                options.band_reach
+                    && !options.certified_hits
+                    && options.final_step
+                    && options.reach_steps
+                    && !points
+                    && tol < MAX_PRUNE_TOLERANCE
+                    && h < o.params.beta
+            })
+            .collect();
         let refine = step_beta.iter().zip(&hit_beta).any(|(s, h)| s != h);
         let tau = options.epsilon
             * if points_only.iter().all(|&p| p) {
@@ -374,6 +372,7 @@ impl<'a> Tracer<'a> {
             tau,
             weighted: points_only.iter().map(|&p| !p).collect(),
             aims,
+            band_reach,
             min,
             max,
             options,
@@ -598,7 +597,7 @@ impl<'a> Tracer<'a> {
                 f = self.sample(x, &mut stats, Want::Gradient, true, level, along, step_beta);
             }
             near = f.s - gap < 2.0 * tau;
-            if f.s.abs() <= eps {
+            if f.s.abs() <= eps || (f_fine && self.lands_in_band(&f, d)) {
                 let floor = prev.map_or(t, |p| p.0);
                 let hit = if landed {
                     self.landing(o, d, (t, floor), &f, &mut stats)

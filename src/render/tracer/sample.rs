@@ -8,7 +8,8 @@
 //! 3). With one object a sample also carries its free distances along the ray
 //! (`eval::reach`), which steps and neighbours' free cones use.
 
-use super::{RayStats, Tracer};
+use super::Tracer;
+use super::ray::RayStats;
 use crate::eval::{Along, FarShare};
 use crate::render::step_beta::StepBeta;
 use glam::DVec3;
