@@ -32,7 +32,7 @@ pub(super) const FINAL_REACH: f64 = 2.0;
 
 /// A sample at most this many epsilons above the hit band may be the hit (module docs,
 /// item 13),
-pub(super) const BAND_REACH_MAX: f64 = 4.0;
+pub(super) const BAND_REACH_MAX: f64 = 8.0;
 
 /// where its final step is predicted to end at most this many epsilons above zero
 /// (first order, from the gradient),
