@@ -155,9 +155,9 @@
 //!     and the evaluation that would confirm it is spared. Near these surfaces the field
 //!     falls slowly along the ray (`k` of 0.2-0.5) and the free distance lands a few
 //!     epsilons short of the band, so most rays took one more fine evaluation there:
-//!     1-16% fewer full evaluations per hit ray on the soft cells of the speed matrix,
-//!     the hits' 99th percentile depth error against the exact surface a quarter to
-//!     half an epsilon larger (doc/performance-log.md, round twenty-seven). Without the
+//!     2-24% fewer full evaluations per hit ray on the soft cells of the speed matrix,
+//!     the hits' 99th percentile depth error against the exact surface up to half an
+//!     epsilon larger (doc/performance-log.md, round twenty-seven). Without the
 //!     bend, a ray skimming a thin tube of the hex torus took a hit where the field
 //!     rises again and the ray passes by. Off in the paper's mode, with certified hits
 //!     (item 11), and in the speed matrix's exact reference (`TracerOptions::band_reach`).
