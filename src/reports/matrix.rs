@@ -6,9 +6,9 @@
 //!
 //! Per cell it reports the tracing time, the work per ray (full evaluations per hit
 //! ray, bound steps per hit ray, leaves per ray and per evaluation) and, when asked, the
-//! depth error against the exact render (beta 0) of the same view at a smaller size
-//! (`|t - t_0|` over the rays hitting in both, relative to the diagonal, as `sweep`
-//! measures it). The counts do not depend on the machine or the thread count, so a
+//! depth error against the exact render (beta 0, hits in the band only) of the same
+//! view at a smaller size (`|t - t_0|` over the rays hitting in both, relative to the
+//! diagonal, as `sweep` measures it). The counts do not depend on the machine or the thread count, so a
 //! committed baseline of them guards every cell (`check`): a cell whose leaves or
 //! evaluations per ray rise by more than the tolerance fails.
 
