@@ -153,7 +153,7 @@
 //!     it lifts the field). The step is the final step's, as certain as it is, so the
 //!     hit stays in front of the surface; only its landing in the band is predicted,
 //!     and the evaluation that would confirm it is spared. Near these surfaces the field
-//!     falls slowly along the ray (`k` of 0.2-0.5) and the free distance lands a few
+//!     falls slowly along the ray (`k` of 0.2-0.8) and the free distance lands a few
 //!     epsilons short of the band, so most rays took one more fine evaluation there:
 //!     2-24% fewer full evaluations per hit ray on the soft cells of the speed matrix,
 //!     the hits' 99th percentile depth error against the exact surface up to half an
