@@ -306,45 +306,48 @@ impl<'a> Tracer<'a> {
                 }
             })
             .collect();
-        // Far terms by share on edges and triangles where the hit band is narrow against
-        // the kernel (the pruning tolerance below its cap, `alpha epsilon < 0.4`): there
-        // a sum has many terms. Where it is capped, pruning already takes shares of 1%
-        // (item 9; doc/performance-log.md, round twenty-two). Not with certified hits,
-        // whose halvings of the hit beta must reach the exact sum (item 11).
+        // Per object: its hit band is narrow against the kernel (`alpha epsilon < 0.4`,
+        // the pruning tolerance of item 6 below its cap), where a sum holds many terms.
+        // Far terms by share (item 9), aimed steps (item 12) and hits from above the band
+        // (item 13) are taken only there.
+        let narrow: Vec<bool> = tolerance
+            .iter()
+            .map(|&tol| tol < MAX_PRUNE_TOLERANCE)
+            .collect();
+        // Far terms by share on narrow edges and triangles. Where the tolerance is
+        // capped, pruning already takes shares of 1% (item 9; doc/performance-log.md,
+        // round twenty-two). Not with certified hits, whose halvings of the hit beta must
+        // reach the exact sum (item 11).
         let far_share = points_only
             .iter()
-            .zip(&tolerance)
-            .map(|(&points, &tol)| {
-                if points || tol >= MAX_PRUNE_TOLERANCE || options.certified_hits {
+            .zip(&narrow)
+            .map(|(&points, &narrow)| {
+                if points || !narrow || options.certified_hits {
                     0.0
                 } else {
                     options.far_share
                 }
             })
             .collect();
-        // Aimed steps (item 12): point clouds whose hit band is narrow against the
-        // kernel (the pruning tolerance below its cap, `alpha epsilon < 0.4`).
+        // Aimed steps on narrow point clouds (item 12).
         let aims = points_only
             .iter()
-            .zip(&tolerance)
-            .map(|(&points, &tol)| {
-                options.aim && options.reach_steps && points && tol < MAX_PRUNE_TOLERANCE
-            })
+            .zip(&narrow)
+            .map(|(&points, &narrow)| options.aim && options.reach_steps && points && narrow)
             .collect();
-        // Hits from above the band (item 13): edges and triangles whose hit band is
-        // narrow against the kernel (the pruning tolerance below its cap), where their
-        // hits are decided at the hit beta (`sticky`).
+        // Hits from above the band on narrow edges and triangles whose hits are decided
+        // at the hit beta (`sticky`; item 13).
         let band_reach = points_only
             .iter()
-            .zip(&tolerance)
+            .zip(&narrow)
             .zip(objects.iter().zip(&hit_beta))
-            .map(|((&points, &tol), (o, &h))| {
+            .map(|((&points, &narrow), (o, &h))| {
                 options.band_reach
                     && !options.certified_hits
                     && options.final_step
                     && options.reach_steps
                     && !points
-                    && tol < MAX_PRUNE_TOLERANCE
+                    && narrow
                     && h < o.params.beta
             })
             .collect();
