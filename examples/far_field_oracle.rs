@@ -1,0 +1,573 @@
+//! Far-field oracle: how far below the exact smooth distance a Barnes-Hut sum over an
+//! edge or triangle mesh lies at the hits, for the engine's far-field term and for
+//! tighter ones that could replace it (doc/performance-log.md, round twenty-eight).
+//!
+//! At the hits of the scene's own tracer (every `STEP`-th pixel of every `STEP`-th row,
+//! 480x270), a plain Barnes-Hut walk over the binary BVH (no pruning) takes a subtree
+//! as one far term where its box diagonal is below `beta` times its distance, and
+//! sums it by each of these bounds (all of them at least the subtree's exact sum):
+//! - `box, max weight`: `n w_max exp(-alpha r)`, `r` the distance to the box (the
+//!   engine's far term for edges and triangles, SPEC 6);
+//! - `box, actual weights`: the primitives' weights at their closest points (an
+//!   oracle: a walk does not know them);
+//! - `box, cone weights`: each primitive's largest weight at a point that can be its
+//!   closest from the directions in which the query sees the box (a vertex always; an
+//!   edge's interior only where some such direction is perpendicular to it; a face's
+//!   interior only where one is along its normal), the cone widened by `WIDEN` degrees
+//!   as a table over direction bins would widen it;
+//! - `directional`: `|x - p| >= u . (x - p)` for `u` the unit direction from the box
+//!   centre `c` to `x`, so a primitive's term is at most `w exp(-alpha (u . (x - c) -
+//!   s(u)))`, `s(u)` its largest `u . (p - c)` over its vertices; with the largest
+//!   weight, cone weights or actual weights (the exact direction: a table over
+//!   directions loses some of it);
+//! - `directional, weighted support`: the largest `u . (p - c) + ln w(p) / alpha` over
+//!   the primitive (no knowledge of the closest point needed);
+//! - `weighted support, 25-direction grid`: the same summed per subtree in the log
+//!   domain, `D(v) = ln sum exp(alpha s(v))`, tabulated at an octahedral grid of 25
+//!   directions scaled out by `S` and at `v = 0`, and bounded between them by its
+//!   convexity (`Grid`; the bound the round proposes). Each such term is checked
+//!   against its subtree's exact sum, and the count below it printed;
+//! - `centroid moments`: Bennett's bound on the centroids, each primitive within `rho`
+//!   of its centroid (`exp(alpha rho_max)` more), the largest weight (the bound of
+//!   point clouds, `eval::smooth`, carried over to primitives with extent).
+//!
+//! The weights' maxima over an edge or a face are sampled (17 points per edge, 66 per
+//! face, 91 per primitive for the weighted support), not bounded: these are
+//! measurements of what a bound could reach, not bounds.
+//! Printed per beta: leaves (exact terms plus far terms) per point and the median and
+//! 90th percentile of each sum's deficit below the exact value, in epsilons.
+//!
+//! `cargo run --release --example far_field_oracle -- SCENE [STEP] [WIDEN] [BETAS]`
+//! (defaults 7, 0, `0.35,0.5,0.7,1`).
+use glam::DVec3;
+use smoothtrace::bvh::Node;
+use smoothtrace::primitives::{AnySet, Edge, Primitive, PrimitiveSet, Triangle, WeightScale};
+use smoothtrace::render::TracerOptions;
+use smoothtrace::render::build::build_scene;
+use smoothtrace::render::tracer::Tracer;
+use smoothtrace::reports::quantile;
+use smoothtrace::scene::Scene;
+use std::path::Path;
+
+const NAMES: [&str; 9] = [
+    "box, max weight",
+    "box, actual weights",
+    "box, cone weights",
+    "directional, max weight",
+    "directional, cone weights",
+    "directional, actual weights",
+    "directional, weighted support",
+    "centroid moments",
+    "weighted support, 25-direction grid",
+];
+
+/// What a far term needs to know of one primitive: its vertices (an edge's second
+/// repeated), the largest weight at a vertex, along each edge and over the face, the
+/// edges' unit directions and the face's unit normal (zero for an edge).
+struct Shape {
+    v: [DVec3; 3],
+    w_vertex: f64,
+    w_edge: [f64; 3],
+    dir_edge: [DVec3; 3],
+    w_face: f64,
+    normal: DVec3,
+}
+
+trait Vertices: Primitive {
+    fn vertices(&self) -> [DVec3; 3];
+}
+
+impl Vertices for Triangle {
+    fn vertices(&self) -> [DVec3; 3] {
+        [self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3()]
+    }
+}
+
+impl Vertices for Edge {
+    fn vertices(&self) -> [DVec3; 3] {
+        [self.a.as_dvec3(), self.b.as_dvec3(), self.b.as_dvec3()]
+    }
+}
+
+fn shape<P: Vertices>(p: &P, scale: &WeightScale) -> Shape {
+    let v = p.vertices();
+    let w = |q: DVec3| p.value(q, scale).1;
+    let w_vertex = v.iter().map(|&q| w(q)).fold(0.0, f64::max);
+    let mut w_edge = [0.0; 3];
+    let mut dir_edge = [DVec3::ZERO; 3];
+    for e in 0..3 {
+        let (a, b) = (v[e], v[(e + 1) % 3]);
+        dir_edge[e] = (b - a).normalize_or_zero();
+        w_edge[e] = (0..=16)
+            .map(|j| w(a + (b - a) * (j as f64 / 16.0)))
+            .fold(0.0, f64::max);
+    }
+    let mut w_face = w_vertex;
+    for i in 0..=10 {
+        for j in 0..=(10 - i) {
+            let q = v[0] + (v[1] - v[0]) * (i as f64 / 10.0) + (v[2] - v[0]) * (j as f64 / 10.0);
+            w_face = w_face.max(w(q));
+        }
+    }
+    Shape {
+        v,
+        w_vertex,
+        w_edge,
+        dir_edge,
+        w_face,
+        normal: (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero(),
+    }
+}
+
+impl Shape {
+    /// The largest weight of a point that can be closest to a query seen in directions
+    /// within `sin_t` (sine of the half-angle) of `u`.
+    fn cone_weight(&self, u: DVec3, sin_t: f64) -> f64 {
+        let mut w = self.w_vertex;
+        for e in 0..3 {
+            if self.dir_edge[e] != DVec3::ZERO && u.dot(self.dir_edge[e]).abs() <= sin_t {
+                w = w.max(self.w_edge[e]);
+            }
+        }
+        let cos_t = (1.0 - sin_t * sin_t).max(0.0).sqrt();
+        if self.normal != DVec3::ZERO && u.dot(self.normal).abs() >= cos_t {
+            w = w.max(self.w_face);
+        }
+        w
+    }
+
+    /// `max u . (p - c)` over the vertices.
+    fn support(&self, u: DVec3, c: DVec3) -> f64 {
+        self.v
+            .iter()
+            .map(|&p| u.dot(p - c))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// An octahedral grid of `G x G` directions (round twenty-one's layout): the squares
+/// of the parameter square `[-1, 1]^2` split into triangles that stay within one face
+/// of the octahedron, where the map to the octahedron is affine, so that a direction
+/// `u` is `sum mu_k g_k` over its triangle's unit grid directions `g_k`, `mu_k >= 0`.
+struct Grid {
+    /// Points of the octahedron `|x| + |y| + |z| = 1` at the grid's vertices.
+    oct: Vec<DVec3>,
+    /// Their directions, scaled by `scale`.
+    dirs: Vec<DVec3>,
+    /// The largest `sum mu_k` over all unit directions, and a little more.
+    scale: f64,
+}
+
+const G: usize = 5;
+
+impl Grid {
+    fn new() -> Grid {
+        let h = 2.0 / (G - 1) as f64;
+        let mut oct = Vec::new();
+        for j in 0..G {
+            for i in 0..G {
+                oct.push(Self::decode(-1.0 + i as f64 * h, -1.0 + j as f64 * h));
+            }
+        }
+        let mut grid = Grid {
+            dirs: Vec::new(),
+            oct,
+            scale: 1.0,
+        };
+        let mut worst: f64 = 1.0;
+        for a in 0..400 {
+            for b in 0..200 {
+                let (th, ph) = (
+                    b as f64 / 199.0 * std::f64::consts::PI,
+                    a as f64 / 400.0 * std::f64::consts::TAU,
+                );
+                let u = DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
+                let (_, mu) = grid.weights(u);
+                worst = worst.max(mu.iter().sum());
+            }
+        }
+        grid.scale = worst * 1.01;
+        grid.dirs = grid
+            .oct
+            .iter()
+            .map(|o| o.normalize() * grid.scale)
+            .collect();
+        grid
+    }
+
+    fn decode(px: f64, py: f64) -> DVec3 {
+        let z = 1.0 - px.abs() - py.abs();
+        if z >= 0.0 {
+            DVec3::new(px, py, z)
+        } else {
+            DVec3::new(
+                (1.0 - py.abs()) * px.signum(),
+                (1.0 - px.abs()) * py.signum(),
+                z,
+            )
+        }
+    }
+
+    /// The grid vertices of `u`'s triangle and `mu` (`u = sum mu_k g_k`, `g_k` unit).
+    fn weights(&self, u: DVec3) -> ([usize; 3], [f64; 3]) {
+        let o = u / (u.x.abs() + u.y.abs() + u.z.abs());
+        let (px, py) = if o.z >= 0.0 {
+            (o.x, o.y)
+        } else {
+            (
+                (1.0 - o.y.abs()) * o.x.signum(),
+                (1.0 - o.x.abs()) * o.y.signum(),
+            )
+        };
+        let h = 2.0 / (G - 1) as f64;
+        let fi = ((px + 1.0) / h).clamp(0.0, (G - 1) as f64 - 1e-9);
+        let fj = ((py + 1.0) / h).clamp(0.0, (G - 1) as f64 - 1e-9);
+        let (i, j) = (fi.floor() as usize, fj.floor() as usize);
+        let (fx, fy) = (fi - i as f64, fj - j as f64);
+        let v = |a: usize, b: usize| (j + b) * G + i + a;
+        // Squares in the quadrants where px and py have one sign split along the
+        // anti-diagonal, the others along the diagonal (the fold lines |px| + |py| = 1).
+        let centre_x = -1.0 + (i as f64 + 0.5) * h;
+        let centre_y = -1.0 + (j as f64 + 0.5) * h;
+        let (idx, lam) = if centre_x * centre_y > 0.0 {
+            if fx + fy <= 1.0 {
+                ([v(0, 0), v(1, 0), v(0, 1)], [1.0 - fx - fy, fx, fy])
+            } else {
+                (
+                    [v(1, 1), v(1, 0), v(0, 1)],
+                    [fx + fy - 1.0, 1.0 - fy, 1.0 - fx],
+                )
+            }
+        } else if fx >= fy {
+            ([v(0, 0), v(1, 0), v(1, 1)], [1.0 - fx, fx - fy, fy])
+        } else {
+            ([v(0, 0), v(0, 1), v(1, 1)], [1.0 - fy, fy - fx, fx])
+        };
+        let ou = o.length();
+        let mu = [0, 1, 2].map(|k| lam[k].max(0.0) * self.oct[idx[k]].length() / ou);
+        (idx, mu)
+    }
+}
+
+/// Log-sum-exp of two logarithms.
+fn lse(a: f64, b: f64) -> f64 {
+    let m = a.max(b);
+    if m == f64::NEG_INFINITY {
+        m
+    } else {
+        m + ((a - m).exp() + (b - m).exp()).ln()
+    }
+}
+
+/// The first primitive (in leaf order) below each node of a binary BVH.
+fn starts(nodes: &[Node]) -> Vec<usize> {
+    fn fill(nodes: &[Node], i: usize, start: &mut [usize]) -> usize {
+        let n = &nodes[i];
+        start[i] = if n.is_leaf() {
+            n.index as usize
+        } else {
+            let s = fill(nodes, i + 1, start);
+            fill(nodes, n.index as usize, start);
+            s
+        };
+        start[i]
+    }
+    let mut start = vec![0; nodes.len()];
+    if !nodes.is_empty() {
+        fill(nodes, 0, &mut start);
+    }
+    start
+}
+
+struct Oracle<'s, P> {
+    set: &'s PrimitiveSet<P>,
+    scale: WeightScale,
+    alpha: f64,
+    shapes: Vec<Shape>,
+    start: Vec<usize>,
+    widen: f64,
+    grid: Grid,
+    /// Per node: `alpha` times its weighted support at each scaled grid direction,
+    /// about the origin, summed over its primitives in the log domain, and (last) at
+    /// the zero direction (`ln sum w_max`).
+    tables: Vec<Vec<f64>>,
+    /// Far terms whose grid bound fell below their exact sum, and the worst ratio.
+    violations: std::cell::Cell<usize>,
+    worst: std::cell::Cell<f64>,
+}
+
+impl<P: Vertices> Oracle<'_, P> {
+    /// Each bound's sum at `x` for `beta`, the exact sum, and the leaves.
+    fn sums(&self, x: DVec3, beta: f64) -> ([f64; 9], f64, usize) {
+        let (nodes, prims, alpha) = (&self.set.bvh.nodes, &self.set.prims, self.alpha);
+        let w_max = self.scale.max_weight();
+        let mut sums = [0.0; 9];
+        let (mut exact, mut leaves) = (0.0, 0);
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            let n = &nodes[i];
+            let r = n.distance_squared(x).sqrt();
+            let range = self.start[i]..self.start[i] + n.size as usize;
+            if r > 0.0 && (n.diam as f64) < beta * r {
+                leaves += 1;
+                let count = n.size as f64;
+                let boxed = (-alpha * r).exp();
+                let c = 0.5 * (n.min.as_dvec3() + n.max.as_dvec3());
+                let l = (x - c).length();
+                let u = (x - c) / l;
+                let half_angle =
+                    (0.5 * n.diam as f64 / l).min(1.0).asin() + self.widen.to_radians();
+                let sin_t = half_angle.min(std::f64::consts::FRAC_PI_2).sin();
+                let mut part = [0.0; 8];
+                let node_exact: f64 = range
+                    .clone()
+                    .map(|k| {
+                        let (d, w) = prims[k].value(x, &self.scale);
+                        w * (-alpha * d).exp()
+                    })
+                    .sum();
+                // Round twenty-eight's proposal: the weighted support tabulated at the
+                // grid and bounded between them by convexity.
+                {
+                    let t = &self.tables[i];
+                    let (idx, mu) = self.grid.weights(u);
+                    let m: f64 = mu.iter().sum();
+                    let sc = self.grid.scale;
+                    let mut d = (1.0 - m / sc) * t[G * G];
+                    for k in 0..3 {
+                        // About the centre c: the support shifts by -g . c.
+                        let g = self.grid.dirs[idx[k]];
+                        d += mu[k] / sc * (t[idx[k]] - alpha * g.dot(c));
+                    }
+                    let bound = (-alpha * u.dot(x - c) + d).exp();
+                    if bound < node_exact * (1.0 - 1e-9) {
+                        self.violations.set(self.violations.get() + 1);
+                        let r = node_exact / bound;
+                        if r > self.worst.get() {
+                            self.worst.set(r);
+                        }
+                    }
+                    sums[8] += bound.min(count * w_max * boxed);
+                }
+                let (mut moment_var, mut moment_z, mut rho_max) = (0.0, 0.0f64, 0.0f64);
+                let mean: DVec3 = range
+                    .clone()
+                    .map(|k| prims[k].centroid().as_dvec3())
+                    .sum::<DVec3>()
+                    / count;
+                for k in range.clone() {
+                    let (d, w) = prims[k].value(x, &self.scale);
+                    let s = &self.shapes[k];
+                    let term = w * (-alpha * d).exp();
+                    exact += term;
+                    let wc = s.cone_weight(u, sin_t);
+                    part[1] += w;
+                    part[2] += wc;
+                    let dir = (-alpha * (l - s.support(u, c))).exp();
+                    part[3] += w_max * dir;
+                    part[4] += wc * dir;
+                    part[5] += w * dir;
+                    let weighted = (0..=12)
+                        .flat_map(|i| (0..=(12 - i)).map(move |j| (i, j)))
+                        .map(|(i, j)| {
+                            let q = s.v[0]
+                                + (s.v[1] - s.v[0]) * (i as f64 / 12.0)
+                                + (s.v[2] - s.v[0]) * (j as f64 / 12.0);
+                            u.dot(q - c) + prims[k].value(q, &self.scale).1.ln() / alpha
+                        })
+                        .fold(f64::NEG_INFINITY, f64::max);
+                    part[6] += (-alpha * (l - weighted)).exp();
+                    let cm = prims[k].centroid().as_dvec3();
+                    let a = u.dot(cm - mean);
+                    moment_var += a * a / count;
+                    moment_z = moment_z.max(alpha * a);
+                    rho_max =
+                        rho_max.max(s.v.iter().map(|&p| (p - cm).length()).fold(0.0, f64::max));
+                }
+                let box_term = count * w_max * boxed;
+                sums[0] += box_term;
+                sums[1] += part[1] * boxed;
+                sums[2] += part[2] * boxed;
+                // A directional term is a bound as well: the smaller of the two is.
+                sums[3] += part[3].min(box_term);
+                sums[4] += part[4].min(part[2] * boxed);
+                sums[5] += part[5].min(part[1] * boxed);
+                sums[6] += part[6].min(box_term);
+                let g = if moment_z < 1e-9 {
+                    0.5
+                } else {
+                    (moment_z.exp() - 1.0 - moment_z) / (moment_z * moment_z)
+                };
+                let lm = (x - mean).length();
+                let moments = count
+                    * w_max
+                    * (alpha * rho_max).exp()
+                    * (1.0 + alpha * alpha * moment_var * g)
+                    * (-alpha * lm).exp();
+                sums[7] += moments.min(box_term);
+            } else if n.is_leaf() {
+                for k in range {
+                    leaves += 1;
+                    let (d, w) = prims[k].value(x, &self.scale);
+                    let term = w * (-alpha * d).exp();
+                    exact += term;
+                    for s in sums.iter_mut() {
+                        *s += term;
+                    }
+                }
+            } else {
+                stack.push(i + 1);
+                stack.push(n.index as usize);
+            }
+        }
+        (sums, exact, leaves)
+    }
+}
+
+fn run<P: Vertices>(
+    set: &PrimitiveSet<P>,
+    points: &[DVec3],
+    alpha: f64,
+    max_alpha: f64,
+    eps: f64,
+    widen: f64,
+    betas: &[f64],
+) {
+    let scale = WeightScale::new(set.max_adj, alpha, max_alpha);
+    let grid = Grid::new();
+    println!("grid: {} directions, scaled by {:.4}", G * G, grid.scale);
+    // Per primitive, sampled: max over p of alpha (g . p) + ln w(p), for each g.
+    let prim_tables: Vec<Vec<f64>> = set
+        .prims
+        .iter()
+        .map(|p| {
+            let v = p.vertices();
+            let samples: Vec<(DVec3, f64)> = (0..=12)
+                .flat_map(|i| (0..=(12 - i)).map(move |j| (i, j)))
+                .map(|(i, j)| {
+                    let q = v[0]
+                        + (v[1] - v[0]) * (i as f64 / 12.0)
+                        + (v[2] - v[0]) * (j as f64 / 12.0);
+                    (q, p.value(q, &scale).1.ln())
+                })
+                .collect();
+            let mut t: Vec<f64> = grid
+                .dirs
+                .iter()
+                .map(|g| {
+                    samples
+                        .iter()
+                        .map(|&(q, lw)| alpha * g.dot(q) + lw)
+                        .fold(f64::NEG_INFINITY, f64::max)
+                })
+                .collect();
+            t.push(
+                samples
+                    .iter()
+                    .map(|s| s.1)
+                    .fold(f64::NEG_INFINITY, f64::max),
+            );
+            t
+        })
+        .collect();
+    let start = starts(&set.bvh.nodes);
+    let tables: Vec<Vec<f64>> = set
+        .bvh
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(i, n)| {
+            let mut t = vec![f64::NEG_INFINITY; G * G + 1];
+            for prim in &prim_tables[start[i]..start[i] + n.size as usize] {
+                for (a, b) in t.iter_mut().zip(prim) {
+                    *a = lse(*a, *b);
+                }
+            }
+            t
+        })
+        .collect();
+    let oracle = Oracle {
+        violations: Default::default(),
+        worst: std::cell::Cell::new(1.0),
+        grid,
+        tables,
+        set,
+        shapes: set.prims.iter().map(|p| shape(p, &scale)).collect(),
+        scale,
+        alpha,
+        start,
+        widen,
+    };
+    for &beta in betas {
+        let mut deficits: Vec<Vec<f64>> = vec![Vec::new(); NAMES.len()];
+        let mut leaves = 0;
+        for &x in points {
+            let (sums, exact, n) = oracle.sums(x, beta);
+            leaves += n;
+            for (d, s) in deficits.iter_mut().zip(sums) {
+                // s_exact - s_bound = ln(sum_bound / sum_exact) / alpha.
+                d.push((s / exact).ln() / alpha / eps);
+            }
+        }
+        println!(
+            "beta {beta}: {:.0} leaves per point; grid bound below the exact sum: {} far terms (worst by {:.3e})",
+            leaves as f64 / points.len() as f64,
+            oracle.violations.get(),
+            oracle.worst.get() - 1.0
+        );
+        for (name, d) in NAMES.iter().zip(&mut deficits) {
+            println!(
+                "  {name:30} deficit p50 {:.3}, p90 {:.3} epsilons",
+                quantile(d, 0.5).unwrap_or(f64::NAN),
+                quantile(d, 0.9).unwrap_or(f64::NAN)
+            );
+        }
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let Some(path) = args.get(1) else {
+        eprintln!("usage: far_field_oracle SCENE [STEP] [WIDEN] [BETAS]");
+        std::process::exit(2);
+    };
+    let step: usize = args
+        .get(2)
+        .map_or(7, |s| s.parse().expect("STEP: a pixel stride"));
+    let widen: f64 = args
+        .get(3)
+        .map_or(0.0, |s| s.parse().expect("WIDEN: degrees"));
+    let betas: Vec<f64> = args.get(4).map_or(vec![0.35, 0.5, 0.7, 1.0], |s| {
+        s.split(',')
+            .map(|b| b.parse().expect("BETAS: a list like 0.35,0.5"))
+            .collect()
+    });
+    let mut scene = Scene::load(Path::new(path)).expect("scene");
+    scene.image.width = 480;
+    scene.image.height = 270;
+    let built = build_scene(&scene).expect("build");
+    let tracer = Tracer::new(
+        &built.objects,
+        TracerOptions::new(built.epsilon, scene.render.max_steps),
+    );
+    let mut points = Vec::new();
+    for py in (0..270).step_by(step) {
+        for px in (0..480).step_by(step) {
+            let (o, d) = built.camera.ray(px, py);
+            if let Some(hit) = tracer.trace(o, d, 0.0).hit {
+                points.push(hit.point);
+            }
+        }
+    }
+    let obj = &built.objects[0];
+    let (alpha, max_alpha) = (obj.params.alpha, obj.params.max_alpha);
+    println!(
+        "{} hit points, alpha {alpha}, widened by {widen} degrees",
+        points.len()
+    );
+    match obj.set_refs()[0] {
+        AnySet::Triangles(set) => run(set, &points, alpha, max_alpha, built.epsilon, widen, &betas),
+        AnySet::Edges(set) => run(set, &points, alpha, max_alpha, built.epsilon, widen, &betas),
+        AnySet::Points(_) => eprintln!("points: their far terms are moment bounds already"),
+    }
+}
