@@ -25,7 +25,7 @@
 //! - `weighted support, 25-direction grid`: the same summed per subtree in the log
 //!   domain, `D(v) = ln sum exp(alpha s(v))`, tabulated at an octahedral grid of 25
 //!   directions scaled out by `S` and at `v = 0`, and bounded between them by its
-//!   convexity (`Grid`; the bound the round proposes). Each such term is checked
+//!   convexity (`geometry::directions`; the bound the round proposes). Each such term is checked
 //!   against its subtree's exact sum, and the count below it printed;
 //! - `centroid moments`: Bennett's bound on the centroids, each primitive within `rho`
 //!   of its centroid (`exp(alpha rho_max)` more), the largest weight (the bound of
@@ -43,6 +43,7 @@
 //! (defaults 7, 0, `0.35,0.5,0.7,1`).
 use glam::DVec3;
 use smoothtrace::bvh::Node;
+use smoothtrace::geometry::directions::DirectionGrid;
 use smoothtrace::primitives::{AnySet, Edge, Primitive, PrimitiveSet, Triangle, WeightScale};
 use smoothtrace::render::TracerOptions;
 use smoothtrace::render::build::build_scene;
@@ -191,109 +192,8 @@ impl Shape {
     }
 }
 
-/// An octahedral grid of `G x G` directions (round twenty-one's layout): the squares
-/// of the parameter square `[-1, 1]^2` split into triangles that stay within one face
-/// of the octahedron, where the map to the octahedron is affine, so that a direction
-/// `u` is `sum mu_k g_k` over its triangle's unit grid directions `g_k`, `mu_k >= 0`.
-struct Grid {
-    /// Points of the octahedron `|x| + |y| + |z| = 1` at the grid's vertices.
-    oct: Vec<DVec3>,
-    /// Their directions, scaled by `scale`.
-    dirs: Vec<DVec3>,
-    /// The largest `sum mu_k` over all unit directions, and a little more.
-    scale: f64,
-}
-
+/// The grid's size: 5 x 5 directions (round twenty-one's).
 const G: usize = 5;
-
-impl Grid {
-    fn new() -> Grid {
-        let h = 2.0 / (G - 1) as f64;
-        let mut oct = Vec::new();
-        for j in 0..G {
-            for i in 0..G {
-                oct.push(Self::decode(-1.0 + i as f64 * h, -1.0 + j as f64 * h));
-            }
-        }
-        let mut grid = Grid {
-            dirs: Vec::new(),
-            oct,
-            scale: 1.0,
-        };
-        let mut worst: f64 = 1.0;
-        for a in 0..400 {
-            for b in 0..200 {
-                let (th, ph) = (
-                    b as f64 / 199.0 * std::f64::consts::PI,
-                    a as f64 / 400.0 * std::f64::consts::TAU,
-                );
-                let u = DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos());
-                let (_, mu) = grid.weights(u);
-                worst = worst.max(mu.iter().sum());
-            }
-        }
-        grid.scale = worst * 1.01;
-        grid.dirs = grid
-            .oct
-            .iter()
-            .map(|o| o.normalize() * grid.scale)
-            .collect();
-        grid
-    }
-
-    fn decode(px: f64, py: f64) -> DVec3 {
-        let z = 1.0 - px.abs() - py.abs();
-        if z >= 0.0 {
-            DVec3::new(px, py, z)
-        } else {
-            DVec3::new(
-                (1.0 - py.abs()) * px.signum(),
-                (1.0 - px.abs()) * py.signum(),
-                z,
-            )
-        }
-    }
-
-    /// The grid vertices of `u`'s triangle and `mu` (`u = sum mu_k g_k`, `g_k` unit).
-    fn weights(&self, u: DVec3) -> ([usize; 3], [f64; 3]) {
-        let o = u / (u.x.abs() + u.y.abs() + u.z.abs());
-        let (px, py) = if o.z >= 0.0 {
-            (o.x, o.y)
-        } else {
-            (
-                (1.0 - o.y.abs()) * o.x.signum(),
-                (1.0 - o.x.abs()) * o.y.signum(),
-            )
-        };
-        let h = 2.0 / (G - 1) as f64;
-        let fi = ((px + 1.0) / h).clamp(0.0, (G - 1) as f64 - 1e-9);
-        let fj = ((py + 1.0) / h).clamp(0.0, (G - 1) as f64 - 1e-9);
-        let (i, j) = (fi.floor() as usize, fj.floor() as usize);
-        let (fx, fy) = (fi - i as f64, fj - j as f64);
-        let v = |a: usize, b: usize| (j + b) * G + i + a;
-        // Squares in the quadrants where px and py have one sign split along the
-        // anti-diagonal, the others along the diagonal (the fold lines |px| + |py| = 1).
-        let centre_x = -1.0 + (i as f64 + 0.5) * h;
-        let centre_y = -1.0 + (j as f64 + 0.5) * h;
-        let (idx, lam) = if centre_x * centre_y > 0.0 {
-            if fx + fy <= 1.0 {
-                ([v(0, 0), v(1, 0), v(0, 1)], [1.0 - fx - fy, fx, fy])
-            } else {
-                (
-                    [v(1, 1), v(1, 0), v(0, 1)],
-                    [fx + fy - 1.0, 1.0 - fy, 1.0 - fx],
-                )
-            }
-        } else if fx >= fy {
-            ([v(0, 0), v(1, 0), v(1, 1)], [1.0 - fx, fx - fy, fy])
-        } else {
-            ([v(0, 0), v(0, 1), v(1, 1)], [1.0 - fy, fy - fx, fx])
-        };
-        let ou = o.length();
-        let mu = [0, 1, 2].map(|k| lam[k].max(0.0) * self.oct[idx[k]].length() / ou);
-        (idx, mu)
-    }
-}
 
 /// Log-sum-exp of two logarithms.
 fn lse(a: f64, b: f64) -> f64 {
@@ -332,7 +232,7 @@ struct Oracle<'s, P> {
     shapes: Vec<Shape>,
     start: Vec<usize>,
     widen: f64,
-    grid: Grid,
+    grid: DirectionGrid,
     /// Per node: `alpha` times its weighted support at each scaled grid direction,
     /// about the origin, summed over its primitives in the log domain, and (last) at
     /// the zero direction (`ln sum w_max`).
@@ -376,13 +276,13 @@ impl<P: Vertices> Oracle<'_, P> {
                 // grid and bounded between them by convexity.
                 {
                     let t = &self.tables[i];
-                    let (idx, mu) = self.grid.weights(u);
+                    let (idx, mu) = self.grid.cone(u);
                     let m: f64 = mu.iter().sum();
-                    let sc = self.grid.scale;
-                    let mut d = (1.0 - m / sc) * t[G * G];
+                    let sc = self.grid.scale();
+                    let mut d = (1.0 - m / sc) * t[self.grid.len()];
                     for k in 0..3 {
                         // About the centre c: the support shifts by -g . c.
-                        let g = self.grid.dirs[idx[k]];
+                        let g = sc * self.grid.direction(idx[k]);
                         d += mu[k] / sc * (t[idx[k]] - alpha * g.dot(c));
                     }
                     let bound = (-alpha * u.dot(x - c) + d).exp();
@@ -480,8 +380,12 @@ fn run<P: Vertices>(
     betas: &[f64],
 ) {
     let scale = WeightScale::new(set.max_adj, alpha, max_alpha);
-    let grid = Grid::new();
-    println!("grid: {} directions, scaled by {:.4}", G * G, grid.scale);
+    let grid = DirectionGrid::new(G);
+    println!(
+        "grid: {} directions, scaled by {:.4}",
+        grid.len(),
+        grid.scale()
+    );
     // Per primitive, sampled: max over p of alpha (g . p) + ln w(p), for each g.
     let prim_tables: Vec<Vec<f64>> = set
         .prims
@@ -497,10 +401,9 @@ fn run<P: Vertices>(
                     (q, p.value(q, &scale).1.ln())
                 })
                 .collect();
-            let mut t: Vec<f64> = grid
-                .dirs
-                .iter()
-                .map(|&g| {
+            let mut t: Vec<f64> = (0..grid.len())
+                .map(|k| grid.scale() * grid.direction(k))
+                .map(|g| {
                     p.certain_support(g, alpha, &scale).unwrap_or_else(|| {
                         samples
                             .iter()
@@ -528,7 +431,7 @@ fn run<P: Vertices>(
         .iter()
         .enumerate()
         .map(|(i, n)| {
-            let mut t = vec![f64::NEG_INFINITY; G * G + 1];
+            let mut t = vec![f64::NEG_INFINITY; grid.len() + 1];
             for prim in &prim_tables[start[i]..start[i] + n.size as usize] {
                 for (a, b) in t.iter_mut().zip(prim) {
                     *a = lse(*a, *b);

@@ -1,4 +1,7 @@
-//! Exact closest-point queries (SPEC 3), computed in f64 from f32 inputs.
+//! Geometry with no knowledge of primitives' weights: exact closest-point queries
+//! (SPEC 3, computed in f64 from f32 inputs), Morton order for batches of queries, and a
+//! grid of directions for tables of convex functions of a direction.
 
 pub mod closest;
+pub mod directions;
 pub mod morton;

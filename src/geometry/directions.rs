@@ -1,0 +1,245 @@
+//! A grid of unit directions on which a convex function of a direction can be tabulated
+//! and bounded everywhere (doc/performance-log.md, round twenty-eight: a far-field bound
+//! of edges and triangles tabulated over directions).
+//!
+//! The parameter square `[-1, 1]^2` maps onto the octahedron `|x| + |y| + |z| = 1`:
+//! `(px, py)` to `(px, py, 1 - |px| - |py|)` where that is at least 0, and folded below
+//! (`((1 - |py|) sgn px, (1 - |px|) sgn py, 1 - |px| - |py|)`). Within one quadrant of the
+//! square and one side of the fold lines `|px| + |py| = 1` the map is affine. The grid's
+//! `n x n` points (`n` odd, so that the axes are grid lines) split each square into two
+//! triangles along the diagonal that keeps them on one side of the fold. For a unit `u`
+//! whose octahedron point `o_u = u / |u|_1` lies in the triangle with octahedron vertices
+//! `o_1..3` at barycentrics `lambda`, `o_u = sum lambda_k o_k`, so
+//!
+//!   `u = sum mu_k g_k`, with `g_k = o_k / |o_k|` and `mu_k = lambda_k |o_k| / |o_u| >= 0`.
+//!
+//! `M = sum mu_k` is `1 / |p|` for `p = u / M`, the point where `u`'s ray meets the flat
+//! triangle through `g_1..3`, so it is at most [`DirectionGrid::scale`] `S`, one over the
+//! smallest distance from the origin to such a triangle. Then `u` is the convex
+//! combination `sum (mu_k / S) (S g_k) + (1 - M / S) 0`, and any convex `f` satisfies
+//!
+//!   `f(u) <= sum (mu_k / S) f(S g_k) + (1 - M / S) f(0)`,
+//!
+//! which a table of `f` at the scaled grid directions and at 0 bounds.
+
+use super::closest::closest_on_triangle;
+use glam::DVec3;
+
+/// The grid: its directions and scale.
+#[derive(Clone, Debug)]
+pub struct DirectionGrid {
+    n: usize,
+    /// The octahedron points of the grid points, row by row (`py` outer).
+    oct: Vec<DVec3>,
+    /// Their unit directions.
+    unit: Vec<DVec3>,
+    scale: f64,
+}
+
+/// The octahedron point of the parameter point `(px, py)`.
+fn decode(px: f64, py: f64) -> DVec3 {
+    let z = 1.0 - px.abs() - py.abs();
+    if z >= 0.0 {
+        DVec3::new(px, py, z)
+    } else {
+        DVec3::new(
+            (1.0 - py.abs()) * px.signum(),
+            (1.0 - px.abs()) * py.signum(),
+            z,
+        )
+    }
+}
+
+impl DirectionGrid {
+    /// The grid of `n x n` parameter points, `n` odd and at least 3.
+    pub fn new(n: usize) -> DirectionGrid {
+        assert!(n >= 3 && n % 2 == 1, "a direction grid needs an odd n >= 3");
+        let h = 2.0 / (n - 1) as f64;
+        let oct: Vec<DVec3> = (0..n * n)
+            .map(|k| decode(-1.0 + (k % n) as f64 * h, -1.0 + (k / n) as f64 * h))
+            .collect();
+        let unit: Vec<DVec3> = oct.iter().map(|o| o.normalize()).collect();
+        let mut grid = DirectionGrid {
+            n,
+            oct,
+            unit,
+            scale: 1.0,
+        };
+        let mut nearest = f64::INFINITY;
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                for upper in [false, true] {
+                    let t = grid.triangle(i, j, upper);
+                    let [a, b, c] = t.map(|k| grid.unit[k]);
+                    let d = closest_on_triangle(DVec3::ZERO, a, b, c).point.length();
+                    nearest = nearest.min(d);
+                }
+            }
+        }
+        // Rounded up past the rounding of the distance and of `mu`.
+        grid.scale = (1.0 / nearest) * (1.0 + 1e-12);
+        grid
+    }
+
+    /// The number of grid directions.
+    pub fn len(&self) -> usize {
+        self.n * self.n
+    }
+
+    /// Never empty (`n >= 3`).
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// `S`: at least `sum mu_k` for every unit direction (module docs).
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+
+    /// Grid direction `k`, unit length.
+    pub fn direction(&self, k: usize) -> DVec3 {
+        self.unit[k]
+    }
+
+    /// The grid points of triangle `upper` (0 or 1) of square `(i, j)`.
+    fn triangle(&self, i: usize, j: usize, upper: bool) -> [usize; 3] {
+        let v = |a: usize, b: usize| (j + b) * self.n + i + a;
+        let h = 2.0 / (self.n - 1) as f64;
+        let cx = -1.0 + (i as f64 + 0.5) * h;
+        let cy = -1.0 + (j as f64 + 0.5) * h;
+        // Where px and py have one sign the fold line runs along the squares'
+        // anti-diagonals, elsewhere along their diagonals.
+        match (cx * cy > 0.0, upper) {
+            (true, false) => [v(0, 0), v(1, 0), v(0, 1)],
+            (true, true) => [v(1, 1), v(1, 0), v(0, 1)],
+            (false, false) => [v(0, 0), v(1, 0), v(1, 1)],
+            (false, true) => [v(0, 0), v(0, 1), v(1, 1)],
+        }
+    }
+
+    /// The grid directions `k` whose cone holds the unit direction `u` and `mu` (module
+    /// docs: `u = sum mu_k g_k`, `mu_k >= 0`, `sum mu_k <= scale`).
+    pub fn cone(&self, u: DVec3) -> ([usize; 3], [f64; 3]) {
+        let o = u / (u.x.abs() + u.y.abs() + u.z.abs());
+        let (px, py) = if o.z >= 0.0 {
+            (o.x, o.y)
+        } else {
+            (
+                (1.0 - o.y.abs()) * o.x.signum(),
+                (1.0 - o.x.abs()) * o.y.signum(),
+            )
+        };
+        let cells = (self.n - 1) as f64;
+        let fi = ((px + 1.0) * 0.5 * cells).clamp(0.0, cells);
+        let fj = ((py + 1.0) * 0.5 * cells).clamp(0.0, cells);
+        let (i, j) = ((fi as usize).min(self.n - 2), (fj as usize).min(self.n - 2));
+        let (fx, fy) = (fi - i as f64, fj - j as f64);
+        let h = 2.0 / cells;
+        let anti = (-1.0 + (i as f64 + 0.5) * h) * (-1.0 + (j as f64 + 0.5) * h) > 0.0;
+        let (upper, lambda) = if anti {
+            if fx + fy <= 1.0 {
+                (false, [1.0 - fx - fy, fx, fy])
+            } else {
+                (true, [fx + fy - 1.0, 1.0 - fy, 1.0 - fx])
+            }
+        } else if fx >= fy {
+            (false, [1.0 - fx, fx - fy, fy])
+        } else {
+            (true, [1.0 - fy, fy - fx, fx])
+        };
+        let idx = self.triangle(i, j, upper);
+        let ou = o.length();
+        let mu = [0, 1, 2].map(|k| lambda[k].max(0.0) * self.oct[idx[k]].length() / ou);
+        (idx, mu)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn random_units(count: usize, seed: u64) -> Vec<DVec3> {
+        let mut s = seed;
+        let mut r = move || {
+            s = s
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut out = Vec::new();
+        while out.len() < count {
+            let v = DVec3::new(r(), r(), r());
+            if v.length() > 0.05 && v.length() <= 1.0 {
+                out.push(v.normalize());
+            }
+        }
+        // The axes, the fold and the octant corners, where cells meet.
+        for a in [DVec3::X, DVec3::Y, DVec3::Z] {
+            out.push(a);
+            out.push(-a);
+        }
+        out.push(DVec3::new(1.0, 1.0, -1.0).normalize());
+        out.push(DVec3::new(-1.0, 0.5, 0.0).normalize());
+        out.push(DVec3::new(0.3, -0.7, 0.0).normalize());
+        out
+    }
+
+    #[test]
+    fn every_direction_is_a_nonnegative_combination_within_the_scale() {
+        for n in [3, 5, 9] {
+            let grid = DirectionGrid::new(n);
+            let mut widest: f64 = 0.0;
+            for u in random_units(20_000, n as u64) {
+                let (idx, mu) = grid.cone(u);
+                let back: DVec3 = (0..3).map(|k| mu[k] * grid.direction(idx[k])).sum();
+                assert!((back - u).length() < 1e-12, "n {n}: {u} rebuilt as {back}");
+                assert!(mu.iter().all(|&m| m >= 0.0));
+                let m: f64 = mu.iter().sum();
+                assert!(
+                    m <= grid.scale(),
+                    "n {n}: sum mu {m} above {}",
+                    grid.scale()
+                );
+                widest = widest.max(m);
+            }
+            // The scale is the cells' own, not a loose guess.
+            assert!(
+                widest > grid.scale() * 0.98,
+                "n {n}: {widest} against {}",
+                grid.scale()
+            );
+        }
+        // The far-field oracle's grid (doc/performance-log.md, round twenty-eight).
+        let s5 = DirectionGrid::new(5).scale();
+        assert!(s5 > 1.2 && s5 < 1.25, "n 5: scale {s5}");
+    }
+
+    /// A log-sum-exp of supports, the convex function the far-field tables hold: its
+    /// value at any direction is at most the grid's interpolation.
+    #[test]
+    fn a_convex_function_is_bounded_by_its_table() {
+        let grid = DirectionGrid::new(5);
+        let points = random_units(50, 99);
+        let alpha = 7.0;
+        let f = |v: DVec3| {
+            points
+                .iter()
+                .map(|p| (alpha * v.dot(*p)).exp())
+                .sum::<f64>()
+                .ln()
+        };
+        let table: Vec<f64> = (0..grid.len())
+            .map(|k| f(grid.scale() * grid.direction(k)))
+            .collect();
+        let at_zero = f(DVec3::ZERO);
+        for u in random_units(5_000, 3) {
+            let (idx, mu) = grid.cone(u);
+            let m: f64 = mu.iter().sum();
+            let bound = (0..3)
+                .map(|k| mu[k] / grid.scale() * table[idx[k]])
+                .sum::<f64>()
+                + (1.0 - m / grid.scale()) * at_zero;
+            assert!(f(u) <= bound + 1e-9, "{u}: {} above {bound}", f(u));
+        }
+    }
+}
