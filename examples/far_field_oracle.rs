@@ -34,8 +34,8 @@
 //! The weights' maxima over an edge or a face are sampled (17 points per edge, 66 per
 //! face, 91 per primitive for the weighted support), not bounded: these are
 //! measurements of what a bound could reach, not bounds. Except in the grid's tables
-//! on edges: there the weighted support is certain (`Vertices::certain_support`, 32
-//! pieces per edge, the weight quartic's maximum on each from its critical points).
+//! on edges: there the weighted support is certain (`primitives::support`, 32 pieces per
+//! edge, the weight quartic's maximum on each from its critical points).
 //! Printed per beta: leaves (exact terms plus far terms) per point and the median and
 //! 90th percentile of each sum's deficit below the exact value, in epsilons.
 //!
@@ -44,6 +44,7 @@
 use glam::DVec3;
 use smoothtrace::bvh::Node;
 use smoothtrace::geometry::directions::DirectionGrid;
+use smoothtrace::primitives::support::{edge_piece_log_weights, edge_weighted_support};
 use smoothtrace::primitives::{AnySet, Edge, Primitive, PrimitiveSet, Triangle, WeightScale};
 use smoothtrace::render::TracerOptions;
 use smoothtrace::render::build::build_scene;
@@ -97,42 +98,10 @@ impl Vertices for Edge {
         [self.a.as_dvec3(), self.b.as_dvec3(), self.b.as_dvec3()]
     }
 
-    /// On each of 32 pieces of the edge: the linear part's largest value at a piece's
-    /// end, and the weight's largest over the piece, where the quartic `W(t) = c0 + t^2
-    /// (c2 + t (c3 + t c4))` peaks (its ends and the roots of `W'(t) / t`), rounded up.
-    /// The weight is nondecreasing in `W` (`WeightScale::weight`).
+    /// `primitives::support`: certain, from 32 pieces of the edge.
     fn certain_support(&self, g: DVec3, alpha: f64, scale: &WeightScale) -> Option<f64> {
-        use smoothtrace::primitives::weights::{edge_quartic, edge_w};
-        let (a, b) = (self.a.as_dvec3(), self.b.as_dvec3());
-        let c = edge_quartic(1.0 / self.val_a as f64, 1.0 / self.val_b as f64);
-        let w = |t: f64| edge_w(t, c).0;
-        // W'(t) = t (2 c2 + 3 c3 t + 4 c4 t^2).
-        let (qa, qb, qc) = (4.0 * c[3], 3.0 * c[2], 2.0 * c[1]);
-        let mut roots = Vec::new();
-        if qa != 0.0 {
-            let disc = qb * qb - 4.0 * qa * qc;
-            if disc >= 0.0 {
-                roots.push((-qb + disc.sqrt()) / (2.0 * qa));
-                roots.push((-qb - disc.sqrt()) / (2.0 * qa));
-            }
-        } else if qb != 0.0 {
-            roots.push(-qc / qb);
-        }
-        const K: usize = 32;
-        let mut best = f64::NEG_INFINITY;
-        for k in 0..K {
-            let (t0, t1) = (k as f64 / K as f64, (k + 1) as f64 / K as f64);
-            let mut wmax = w(t0).max(w(t1));
-            for &r in &roots {
-                if r > t0 && r < t1 {
-                    wmax = wmax.max(w(r));
-                }
-            }
-            let wmax = wmax * (1.0 + 1e-12) + 1e-15;
-            let lin = (alpha * g.dot(a + (b - a) * t0)).max(alpha * g.dot(a + (b - a) * t1));
-            best = best.max(lin + scale.weight(wmax).ln() * (1.0 + 1e-12));
-        }
-        Some(best)
+        let lw = edge_piece_log_weights(self, scale);
+        Some(edge_weighted_support(self, g, alpha, &lw))
     }
 }
 

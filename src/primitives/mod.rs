@@ -1,11 +1,12 @@
 //! Primitive sets built from a mesh: points, edges, triangles (SPEC 1), their weights
-//! (SPEC 4, 5) and their BVHs (SPEC 6).
+//! (SPEC 4, 5), an edge's weighted support (`support`) and their BVHs (SPEC 6).
 
 use serde::Deserialize;
 
 mod kinds;
 pub mod lanes;
 mod sets;
+pub mod support;
 pub mod weights;
 
 pub use kinds::{Edge, Point, Primitive, Slope, Term, Triangle};

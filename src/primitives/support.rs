@@ -1,0 +1,129 @@
+//! The weighted support of an edge: for a direction `g` and sharpness `alpha`, an upper
+//! bound of `max over p of alpha g . p + ln w(p)` over the edge's points `p`, `w(p)` the
+//! weight the edge gives a query whose closest point is `p` (SPEC 4, 5). A subtree's
+//! terms at `x` are at most `exp(-alpha g . x + D(g))` for `|g| <= 1`, `D` the log-sum of
+//! its primitives' weighted supports: a far-field bound that knows both the directions
+//! and the weights, convex in `g`, so it can be tabulated on `geometry::directions`'
+//! grid (doc/performance-log.md, round twenty-eight, measures what it would buy; the
+//! far-field oracle example builds its tables from this).
+//!
+//! Certain, not sampled: the edge is cut into [`EDGE_PIECES`] pieces; on each, the
+//! linear part's largest value is at one of its ends, and the weight quartic `W(t) = c0 +
+//! t^2 (c2 + t (c3 + t c4))` peaks at an end or where `W'(t) = t (2 c2 + 3 c3 t + 4 c4
+//! t^2)` vanishes inside it. Both are rounded up; the weight is nondecreasing in `W`
+//! ([`WeightScale::weight`]).
+
+use super::kinds::Edge;
+use super::weights::{WeightScale, edge_quartic, edge_w};
+use glam::DVec3;
+
+/// Pieces of an edge: at 32 the bound lies within 0.1-0.25 epsilons of the sampled
+/// maximum on the soft full bunny's far-field terms (8 pieces: 0.4-0.8).
+pub const EDGE_PIECES: usize = 32;
+
+/// The largest `ln w` over each piece of `e` (computed once per edge).
+pub fn edge_piece_log_weights(e: &Edge, scale: &WeightScale) -> [f64; EDGE_PIECES] {
+    let c = edge_quartic(1.0 / e.val_a as f64, 1.0 / e.val_b as f64);
+    let w = |t: f64| edge_w(t, c).0;
+    // The roots of W'(t) / t = 4 c4 t^2 + 3 c3 t + 2 c2.
+    let (qa, qb, qc) = (4.0 * c[3], 3.0 * c[2], 2.0 * c[1]);
+    let mut roots = [f64::NAN; 2];
+    if qa != 0.0 {
+        let disc = qb * qb - 4.0 * qa * qc;
+        if disc >= 0.0 {
+            roots = [
+                (-qb + disc.sqrt()) / (2.0 * qa),
+                (-qb - disc.sqrt()) / (2.0 * qa),
+            ];
+        }
+    } else if qb != 0.0 {
+        roots[0] = -qc / qb;
+    }
+    std::array::from_fn(|k| {
+        let (t0, t1) = (
+            k as f64 / EDGE_PIECES as f64,
+            (k + 1) as f64 / EDGE_PIECES as f64,
+        );
+        // A root just outside the piece by rounding still bounds it: the ends and any
+        // root within a hair of them are all taken.
+        let hair = 1e-9;
+        let peak = roots
+            .iter()
+            .filter(|r| **r > t0 - hair && **r < t1 + hair)
+            .map(|&r| w(r.clamp(0.0, 1.0)))
+            .fold(w(t0).max(w(t1)), f64::max);
+        let raw = peak * (1.0 + 1e-12) + 1e-15;
+        scale.weight(raw).ln() * (1.0 + 1e-12) + 1e-15
+    })
+}
+
+/// The weighted support of `e` in direction `g` (any length) at sharpness `alpha`, from
+/// its pieces' log-weights ([`edge_piece_log_weights`]): at least `alpha g . p + ln w(p)`
+/// at every point `p` of the edge.
+pub fn edge_weighted_support(
+    e: &Edge,
+    g: DVec3,
+    alpha: f64,
+    log_weights: &[f64; EDGE_PIECES],
+) -> f64 {
+    let (a, b) = (e.a.as_dvec3(), e.b.as_dvec3());
+    let (ga, gd) = (alpha * g.dot(a), alpha * g.dot(b - a));
+    let mut best = f64::NEG_INFINITY;
+    let mut lin0 = ga;
+    for (k, lw) in log_weights.iter().enumerate() {
+        let lin1 = ga + gd * ((k + 1) as f64 / EDGE_PIECES as f64);
+        best = best.max(lin0.max(lin1) + lw);
+        lin0 = lin1;
+    }
+    // The products' rounding, relative to their size.
+    best + 1e-12 * (ga.abs() + gd.abs() + 1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn the_bound_covers_every_point_and_stays_close() {
+        let mut seed = 17u64;
+        let mut r = move || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut worst_gap: f64 = 0.0;
+        for case in 0..400 {
+            let mut v = || Vec3::new(r() as f32, r() as f32, r() as f32) * 2.0 - Vec3::ONE;
+            let e = Edge {
+                a: v(),
+                b: v(),
+                val_a: (1 + case % 12) as f32,
+                val_b: (1 + (case / 12) % 7) as f32,
+            };
+            let (max_adj, alpha) = (12.0, 1.0 + 200.0 * r());
+            let scale = WeightScale::new(max_adj, alpha, 100.0 + 200.0 * r());
+            let lw = edge_piece_log_weights(&e, &scale);
+            let g = DVec3::new(r() - 0.5, r() - 0.5, r() - 0.5) * 2.6;
+            let bound = edge_weighted_support(&e, g, alpha, &lw);
+            let (a, b) = (e.a.as_dvec3(), e.b.as_dvec3());
+            let c = edge_quartic(1.0 / e.val_a as f64, 1.0 / e.val_b as f64);
+            let sampled = (0..=4000)
+                .map(|i| i as f64 / 4000.0)
+                .map(|t| alpha * g.dot(a + (b - a) * t) + scale.weight(edge_w(t, c).0).ln())
+                .fold(f64::NEG_INFINITY, f64::max);
+            assert!(
+                bound >= sampled,
+                "case {case}: bound {bound} below {sampled}"
+            );
+            // Within a piece's spread of the linear part (and the weight's).
+            let spread = (alpha * g.dot(b - a)).abs() / EDGE_PIECES as f64;
+            worst_gap = worst_gap.max((bound - sampled) / (spread + 0.05));
+        }
+        assert!(
+            worst_gap <= 1.0,
+            "the bound runs {worst_gap} pieces' spread above"
+        );
+    }
+}
