@@ -27,16 +27,13 @@ pub fn edge_piece_log_weights(e: &Edge, scale: &WeightScale) -> [f64; EDGE_PIECE
     let w = |t: f64| edge_w(t, c).0;
     // The roots of W'(t) / t = 4 c4 t^2 + 3 c3 t + 2 c2.
     let (qa, qb, qc) = (4.0 * c[3], 3.0 * c[2], 2.0 * c[1]);
+    // In the form that loses no digits to cancellation (`q / qa` and `qc / q`).
     let mut roots = [f64::NAN; 2];
-    if qa != 0.0 {
-        let disc = qb * qb - 4.0 * qa * qc;
-        if disc >= 0.0 {
-            roots = [
-                (-qb + disc.sqrt()) / (2.0 * qa),
-                (-qb - disc.sqrt()) / (2.0 * qa),
-            ];
-        }
-    } else if qb != 0.0 {
+    let disc = qb * qb - 4.0 * qa * qc;
+    if qa != 0.0 && disc >= 0.0 {
+        let q = -0.5 * (qb + qb.signum() * disc.sqrt());
+        roots = [q / qa, if q != 0.0 { qc / q } else { f64::NAN }];
+    } else if qa == 0.0 && qb != 0.0 {
         roots[0] = -qc / qb;
     }
     std::array::from_fn(|k| {
