@@ -1,8 +1,10 @@
 //! Primitive sets built from a mesh: points, edges, triangles (SPEC 1), their weights
-//! (SPEC 4, 5), an edge's weighted support (`support`) and their BVHs (SPEC 6).
+//! (SPEC 4, 5), an edge's weighted support and its tables over directions (`support`,
+//! `directional`) and their BVHs (SPEC 6).
 
 use serde::Deserialize;
 
+pub mod directional;
 mod kinds;
 pub mod lanes;
 mod sets;
