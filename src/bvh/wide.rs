@@ -49,6 +49,23 @@ pub struct Node4 {
 }
 
 impl Node4 {
+    /// The box of slot `k`, in f64.
+    #[inline]
+    pub fn slot_box(&self, k: usize) -> (DVec3, DVec3) {
+        (
+            DVec3::new(
+                self.min[0][k] as f64,
+                self.min[1][k] as f64,
+                self.min[2][k] as f64,
+            ),
+            DVec3::new(
+                self.max[0][k] as f64,
+                self.max[1][k] as f64,
+                self.max[2][k] as f64,
+            ),
+        )
+    }
+
     /// Squared distances from `x` to the four child boxes of a wide node (0 inside; `+inf`
     /// for an unused slot, whose box is inverted), in f64, four lanes at a time.
     #[inline(always)]

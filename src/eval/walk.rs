@@ -28,23 +28,6 @@ thread_local! {
     pub(super) static STACK: std::cell::RefCell<Vec<Entry>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-/// The box of slot `k` of a wide node, in f64.
-#[inline]
-fn slot_box(node: &Node4, k: usize) -> (DVec3, DVec3) {
-    (
-        DVec3::new(
-            node.min[0][k] as f64,
-            node.min[1][k] as f64,
-            node.min[2][k] as f64,
-        ),
-        DVec3::new(
-            node.max[0][k] as f64,
-            node.max[1][k] as f64,
-            node.max[2][k] as f64,
-        ),
-    )
-}
-
 /// Far-field terms whose closest-box value is below `exp(-SIGNIFICANT)` of the nearest
 /// distance's term take the closest-box form even when moments are kept: their share of
 /// the sum is too small for the tighter bound to move `s`.
@@ -417,7 +400,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
     /// The far-field term of slot `k` of wide node `i` at squared distance `d2k > 0`.
     #[inline(always)]
     fn far_slot(&mut self, node: &Node4, i: u32, k: usize, d2k: f64) {
-        let bx = slot_box(node, k);
+        let bx = node.slot_box(k);
         let w = node.size[k] as f64 * self.w_ff;
         self.far_entry(i, k, bx, w, (d2k, bx, None));
     }
@@ -427,7 +410,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
     #[inline(always)]
     fn far_middle(&mut self, node: &Node4, i: u32, j: usize, (near, r2m): (usize, f64)) {
         let w = node.mid_size[j] as f64 * self.w_ff;
-        let (b1, b2) = (slot_box(node, 2 * j), slot_box(node, 2 * j + 1));
+        let (b1, b2) = (node.slot_box(2 * j), node.slot_box(2 * j + 1));
         let bx = (b1.0.min(b2.0), b1.1.max(b2.1));
         let (near_box, other) = if near == 2 * j { (b1, b2) } else { (b2, b1) };
         self.far_entry(i, MIDDLE + j, bx, w, (r2m, near_box, Some(other)));

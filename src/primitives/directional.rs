@@ -46,20 +46,7 @@ fn lse(a: f64, b: f64) -> f64 {
 /// The centre of entry `e` of `node` (a middle's: of its two slots' union; a middle that
 /// is a leaf in its slot: that slot's).
 pub fn entry_centre(node: &Node4, e: usize) -> DVec3 {
-    let slot = |k: usize| {
-        (
-            DVec3::new(
-                node.min[0][k] as f64,
-                node.min[1][k] as f64,
-                node.min[2][k] as f64,
-            ),
-            DVec3::new(
-                node.max[0][k] as f64,
-                node.max[1][k] as f64,
-                node.max[2][k] as f64,
-            ),
-        )
-    };
+    let slot = |k: usize| node.slot_box(k);
     let (lo, hi) = if e < MIDDLE {
         slot(e)
     } else {
