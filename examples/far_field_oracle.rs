@@ -44,6 +44,7 @@
 use glam::DVec3;
 use smoothtrace::bvh::Node;
 use smoothtrace::geometry::directions::DirectionGrid;
+use smoothtrace::primitives::directional::lse;
 use smoothtrace::primitives::support::{edge_piece_log_weights, edge_weighted_support};
 use smoothtrace::primitives::{AnySet, Edge, Primitive, PrimitiveSet, Triangle, WeightScale};
 use smoothtrace::render::TracerOptions;
@@ -80,9 +81,14 @@ struct Shape {
 trait Vertices: Primitive {
     fn vertices(&self) -> [DVec3; 3];
 
-    /// A certain upper bound of `max over p of alpha g . p + ln w(p)` (`None`: only
-    /// sampled for this kind).
-    fn certain_support(&self, _g: DVec3, _alpha: f64, _scale: &WeightScale) -> Option<f64> {
+    /// Certain upper bounds of `max over p of alpha g . p + ln w(p)`, one per direction
+    /// `g` of `dirs` (`None`: only sampled for this kind).
+    fn certain_supports(
+        &self,
+        _dirs: &[DVec3],
+        _alpha: f64,
+        _scale: &WeightScale,
+    ) -> Option<Vec<f64>> {
         None
     }
 }
@@ -98,10 +104,19 @@ impl Vertices for Edge {
         [self.a.as_dvec3(), self.b.as_dvec3(), self.b.as_dvec3()]
     }
 
-    /// `primitives::support`: certain, from 32 pieces of the edge.
-    fn certain_support(&self, g: DVec3, alpha: f64, scale: &WeightScale) -> Option<f64> {
+    /// `primitives::support`: certain, from 32 pieces of the edge (their weights once).
+    fn certain_supports(
+        &self,
+        dirs: &[DVec3],
+        alpha: f64,
+        scale: &WeightScale,
+    ) -> Option<Vec<f64>> {
         let lw = edge_piece_log_weights(self, scale);
-        Some(edge_weighted_support(self, g, alpha, &lw))
+        Some(
+            dirs.iter()
+                .map(|&g| edge_weighted_support(self, g, alpha, &lw))
+                .collect(),
+        )
     }
 }
 
@@ -163,16 +178,6 @@ impl Shape {
 
 /// The grid's size: 5 x 5 directions (round twenty-one's).
 const G: usize = 5;
-
-/// Log-sum-exp of two logarithms.
-fn lse(a: f64, b: f64) -> f64 {
-    let m = a.max(b);
-    if m == f64::NEG_INFINITY {
-        m
-    } else {
-        m + ((a - m).exp() + (b - m).exp()).ln()
-    }
-}
 
 /// The first primitive (in leaf order) below each node of a binary BVH.
 fn starts(nodes: &[Node]) -> Vec<usize> {
@@ -355,6 +360,11 @@ fn run<P: Vertices>(
         grid.len(),
         grid.scale()
     );
+    // The grid's scaled directions, then the zero direction.
+    let dirs: Vec<DVec3> = (0..grid.len())
+        .map(|k| grid.scale() * grid.direction(k))
+        .chain([DVec3::ZERO])
+        .collect();
     // Per primitive, sampled: max over p of alpha (g . p) + ln w(p), for each g.
     let prim_tables: Vec<Vec<f64>> = set
         .prims
@@ -370,27 +380,16 @@ fn run<P: Vertices>(
                     (q, p.value(q, &scale).1.ln())
                 })
                 .collect();
-            let mut t: Vec<f64> = (0..grid.len())
-                .map(|k| grid.scale() * grid.direction(k))
-                .map(|g| {
-                    p.certain_support(g, alpha, &scale).unwrap_or_else(|| {
+            p.certain_supports(&dirs, alpha, &scale).unwrap_or_else(|| {
+                dirs.iter()
+                    .map(|&g| {
                         samples
                             .iter()
                             .map(|&(q, lw)| alpha * g.dot(q) + lw)
                             .fold(f64::NEG_INFINITY, f64::max)
                     })
-                })
-                .collect();
-            t.push(
-                p.certain_support(DVec3::ZERO, alpha, &scale)
-                    .unwrap_or_else(|| {
-                        samples
-                            .iter()
-                            .map(|s| s.1)
-                            .fold(f64::NEG_INFINITY, f64::max)
-                    }),
-            );
-            t
+                    .collect()
+            })
         })
         .collect();
     let start = starts(&set.bvh.nodes);
@@ -448,27 +447,41 @@ fn run<P: Vertices>(
     }
 }
 
-fn main() {
+fn main() -> anyhow::Result<()> {
+    use anyhow::{Context, bail};
     let args: Vec<String> = std::env::args().collect();
     let Some(path) = args.get(1) else {
-        eprintln!("usage: far_field_oracle SCENE [STEP] [WIDEN] [BETAS]");
-        std::process::exit(2);
+        bail!("usage: far_field_oracle SCENE [STEP] [WIDEN] [BETAS]");
     };
-    let step: usize = args
-        .get(2)
-        .map_or(7, |s| s.parse().expect("STEP: a pixel stride"));
-    let widen: f64 = args
-        .get(3)
-        .map_or(0.0, |s| s.parse().expect("WIDEN: degrees"));
-    let betas: Vec<f64> = args.get(4).map_or(vec![0.35, 0.5, 0.7, 1.0], |s| {
-        s.split(',')
-            .map(|b| b.parse().expect("BETAS: a list like 0.35,0.5"))
-            .collect()
-    });
-    let mut scene = Scene::load(Path::new(path)).expect("scene");
+    let step: usize =
+        match args.get(2) {
+            Some(s) => s.parse().ok().filter(|&n| n > 0).with_context(|| {
+                format!("STEP: expected a pixel stride of 1 or more, got `{s}`")
+            })?,
+            None => 7,
+        };
+    let widen: f64 = match args.get(3) {
+        Some(s) => s
+            .parse()
+            .ok()
+            .filter(|w: &f64| (0.0..=90.0).contains(w))
+            .with_context(|| format!("WIDEN: expected degrees from 0 to 90, got `{s}`"))?,
+        None => 0.0,
+    };
+    let betas: Vec<f64> = match args.get(4) {
+        Some(s) => s
+            .split(',')
+            .map(|b| b.parse().ok().filter(|b: &f64| *b > 0.0))
+            .collect::<Option<_>>()
+            .with_context(|| {
+                format!("BETAS: expected positive numbers like 0.35,0.5, got `{s}`")
+            })?,
+        None => vec![0.35, 0.5, 0.7, 1.0],
+    };
+    let mut scene = Scene::load(Path::new(path))?;
     scene.image.width = 480;
     scene.image.height = 270;
-    let built = build_scene(&scene).expect("build");
+    let built = build_scene(&scene).with_context(|| format!("building {path}"))?;
     let tracer = Tracer::new(
         &built.objects,
         TracerOptions::new(built.epsilon, scene.render.max_steps),
@@ -491,6 +504,9 @@ fn main() {
     match obj.set_refs()[0] {
         AnySet::Triangles(set) => run(set, &points, alpha, max_alpha, built.epsilon, widen, &betas),
         AnySet::Edges(set) => run(set, &points, alpha, max_alpha, built.epsilon, widen, &betas),
-        AnySet::Points(_) => eprintln!("points: their far terms are moment bounds already"),
+        AnySet::Points(_) => {
+            bail!("{path}: a point cloud; its far terms are moment bounds already")
+        }
     }
+    Ok(())
 }

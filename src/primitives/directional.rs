@@ -34,7 +34,7 @@ pub struct DirectionalTables {
 }
 
 /// `ln(e^a + e^b)`, exact for infinities.
-fn lse(a: f64, b: f64) -> f64 {
+pub fn lse(a: f64, b: f64) -> f64 {
     let m = a.max(b);
     if m == f64::NEG_INFINITY {
         m
