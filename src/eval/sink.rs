@@ -172,6 +172,15 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
         self.far(x, r2, weight, near, other);
     }
 
+    /// The far-field term of a subtree from its directional tables
+    /// (`primitives::directional`): `exp(-alpha d)` with `d = |x - c| - D / alpha` and
+    /// `dir = (x - c) / |x - c|`. For the fixed direction the bound is linear in the
+    /// query point, so its slope along the ray is `dir . u` and it holds all along.
+    #[inline]
+    pub fn far_directional(&mut self, d: f64, dir: DVec3) {
+        self.term(d, 1.0, dir);
+    }
+
     /// A far-field term at distance `d` with unit direction `dir` (the gradient of `d`,
     /// and its slope along the ray is `dir . u` exactly).
     #[inline]

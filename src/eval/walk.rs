@@ -10,6 +10,7 @@ use super::sink::Sink;
 use crate::bvh::moments::{MIDDLE, lin_bound, quadratic_form};
 use crate::bvh::wide::{EMPTY, Root};
 use crate::bvh::{Moments4, Node4};
+use crate::primitives::directional::{DirectionalTables, entry_centre};
 use crate::primitives::{Primitive, PrimitiveSet, WeightScale};
 use glam::DVec3;
 
@@ -51,6 +52,9 @@ pub(super) struct Walk<'w, 'a, P, const GRAD: bool, const SLOPE: bool, const SHA
     w_ff: f64,
     /// Second moments per wide node, when far fields use them (points).
     moments: &'w [Moments4],
+    /// Directional tables, where the set has them for this `alpha` and `q` and far
+    /// fields may be tighter than the closest box (edges of a rendered object).
+    directional: Option<&'w DirectionalTables>,
     /// Share of the sum that subtrees pruned against the budget may hold together (0 =
     /// off; `eval::smooth` module docs).
     budget: f64,
@@ -180,6 +184,10 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
             } else {
                 &[]
             },
+            directional: set
+                .directional
+                .as_deref()
+                .filter(|t| p.moments && !p.upper_bound && t.alpha == p.alpha && t.q == scale.q),
             budget,
             ln2_over_alpha: std::f64::consts::LN_2 / p.alpha,
             alpha_log2e: p.alpha * std::f64::consts::LOG2_E,
@@ -428,9 +436,26 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
         near: (f64, (DVec3, DVec3), Option<(DVec3, DVec3)>),
     ) {
         self.stats.far += 1;
+        // Directional terms, as moment terms, only where the term can matter (within
+        // `SIGNIFICANT` of the nearest distance seen, counting its weight).
+        let ln_w = (((w.to_bits() >> 52) & 0x7ff) as f64 - 1022.0) * std::f64::consts::LN_2;
+        if let Some(t) = self.directional {
+            let reach = self.sink.acc.m + (SIGNIFICANT + ln_w.max(0.0)) * self.inv_alpha;
+            if near.0 < reach * reach {
+                let c = entry_centre(&self.set.bvh.wide[i as usize], e);
+                if let Some((l, d)) = t.bound(i as usize, e, c, self.x) {
+                    // The smaller of the two bounds (either holds; `ln_w` is at least
+                    // `ln w`).
+                    let alpha = t.alpha;
+                    if d - alpha * l < ln_w - alpha * near.0.sqrt() {
+                        self.sink.far_directional(l - d / alpha, (self.x - c) / l);
+                        return;
+                    }
+                }
+            }
+        }
         // Moment terms only where the term can matter: within `SIGNIFICANT` (in units
         // of alpha times distance) of the nearest distance seen, counting its weight.
-        let ln_w = (((w.to_bits() >> 52) & 0x7ff) as f64 - 1022.0) * std::f64::consts::LN_2;
         let reach = self.sink.acc.m + (SIGNIFICANT + ln_w.max(0.0)) * self.inv_alpha;
         match self
             .moments

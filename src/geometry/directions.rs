@@ -29,10 +29,10 @@ use glam::DVec3;
 #[derive(Clone, Debug)]
 pub struct DirectionGrid {
     n: usize,
-    /// The octahedron points of the grid points, row by row (`py` outer).
-    oct: Vec<DVec3>,
-    /// Their unit directions.
+    /// The unit directions of the grid points, row by row (`py` outer).
     unit: Vec<DVec3>,
+    /// The lengths of their octahedron points.
+    oct_len: Vec<f64>,
     scale: f64,
 }
 
@@ -59,10 +59,11 @@ impl DirectionGrid {
             .map(|k| decode(-1.0 + (k % n) as f64 * h, -1.0 + (k / n) as f64 * h))
             .collect();
         let unit: Vec<DVec3> = oct.iter().map(|o| o.normalize()).collect();
+        let oct_len: Vec<f64> = oct.iter().map(|o| o.length()).collect();
         let mut grid = DirectionGrid {
             n,
-            oct,
             unit,
+            oct_len,
             scale: 1.0,
         };
         let mut nearest = f64::INFINITY;
@@ -120,7 +121,8 @@ impl DirectionGrid {
     /// The grid directions `k` whose cone holds the unit direction `u` and `mu` (module
     /// docs: `u = sum mu_k g_k`, `mu_k >= 0`, `sum mu_k <= scale`).
     pub fn cone(&self, u: DVec3) -> ([usize; 3], [f64; 3]) {
-        let o = u / (u.x.abs() + u.y.abs() + u.z.abs());
+        let norm1 = u.x.abs() + u.y.abs() + u.z.abs();
+        let o = u / norm1;
         let (px, py) = if o.z >= 0.0 {
             (o.x, o.y)
         } else {
@@ -148,8 +150,8 @@ impl DirectionGrid {
             (true, [1.0 - fy, fy - fx, fx])
         };
         let idx = self.triangle(i, j, upper);
-        let ou = o.length();
-        let mu = [0, 1, 2].map(|k| lambda[k].max(0.0) * self.oct[idx[k]].length() / ou);
+        // |o_u| = |u| / |u|_1 = 1 / |u|_1 for a unit u.
+        let mu = [0, 1, 2].map(|k| lambda[k].max(0.0) * self.oct_len[idx[k]] * norm1);
         (idx, mu)
     }
 }

@@ -1,6 +1,7 @@
 //! Tables of a far-field bound that knows directions and weights, for the slots and
-//! middles of an edge set's wide tree (doc/performance-log.md, round twenty-eight; not
-//! yet read by the walk).
+//! middles of an edge set's wide tree (doc/performance-log.md, rounds twenty-eight and
+//! twenty-nine). A rendered object's edge sets carry them (`render::object`), and the
+//! walk takes the smaller of a far term's box bound and theirs (`eval::walk`).
 //!
 //! For an entry (slot or middle) with box centre `c` and the primitives `T` below it, and
 //! any unit `u`, each term is at most `exp(-alpha u . (x - c) + alpha s_T(u))` with `s_T`
@@ -13,24 +14,53 @@
 //! minus `alpha v . c`.
 
 use super::kinds::Edge;
-use super::sets::PrimitiveSet;
-use super::support::{edge_piece_log_weights, edge_weighted_support};
+use super::support::{SupportEnvelope, piece_log_weights};
 use super::weights::WeightScale;
 use crate::bvh::Node4;
 use crate::bvh::moments::MIDDLE;
 use crate::bvh::wide::EMPTY;
 use crate::geometry::directions::DirectionGrid;
 use glam::DVec3;
+use std::collections::HashMap;
 
 /// Entries per wide node: four slots, two middles (`bvh::MIDDLE`).
 const ENTRIES: usize = 6;
 
+/// The grid's side: `GRID * GRID` directions (`geometry::directions`).
+const GRID: usize = 5;
+
+/// Values per entry: the grid's directions, then the direction 0.
+const VALUES: usize = GRID * GRID + 1;
+
+/// An entry's values, before rounding to f32.
+type Table = [f64; VALUES];
+
 /// An edge set's tables at one `alpha`.
+#[derive(Debug)]
 pub struct DirectionalTables {
     pub grid: DirectionGrid,
     pub alpha: f64,
+    /// The weights' attenuation exponent the tables were built with.
+    pub q: f64,
     /// Per wide node and entry, the grid's values then the value at 0.
     values: Vec<f32>,
+}
+
+/// Per value, `ln sum exp` over the tables, shifted by the largest (`-inf` for none);
+/// rounded as well as [`lse`], up to a relative `tables.len() * 1e-16`.
+fn log_sum_exp(tables: &[Table]) -> Table {
+    std::array::from_fn(|d| {
+        let m = tables.iter().fold(f64::NEG_INFINITY, |m, t| m.max(t[d]));
+        if m == f64::NEG_INFINITY {
+            return m;
+        }
+        // The largest terms are 1 (no exponential needed).
+        let sum: f64 = tables
+            .iter()
+            .map(|t| if t[d] == m { 1.0 } else { (t[d] - m).exp() })
+            .sum();
+        m + sum.ln()
+    })
 }
 
 /// `ln(e^a + e^b)`, exact for infinities.
@@ -39,7 +69,7 @@ pub fn lse(a: f64, b: f64) -> f64 {
     if m == f64::NEG_INFINITY {
         m
     } else {
-        m + ((a - m).exp() + (b - m).exp()).ln()
+        m + (a.min(b) - m).exp().ln_1p()
     }
 }
 
@@ -62,86 +92,123 @@ pub fn entry_centre(node: &Node4, e: usize) -> DVec3 {
 }
 
 impl DirectionalTables {
-    /// The tables of `set` at sharpness `alpha` (weights by `scale`), on a 5 x 5 grid.
-    pub fn for_edges(set: &PrimitiveSet<Edge>, alpha: f64, scale: &WeightScale) -> Self {
-        let grid = DirectionGrid::new(5);
-        let n = grid.len() + 1;
-        let dirs: Vec<DVec3> = (0..grid.len())
-            .map(|k| grid.scale() * grid.direction(k))
+    /// The tables of `set` at sharpness `alpha` (weights by `scale`), on a
+    /// [`GRID`] x [`GRID`] grid. The leaves' slots are summed in parallel, then the
+    /// tree a level at a time, then the entries moved to their centres in parallel.
+    /// `prims` are the edges in the tree's order and `wide` its nodes.
+    pub fn for_edges(prims: &[Edge], wide: &[Node4], alpha: f64, scale: &WeightScale) -> Self {
+        use rayon::prelude::*;
+        let grid = DirectionGrid::new(GRID);
+        // The grid's scaled directions, then 0.
+        let dirs: [DVec3; VALUES] = std::array::from_fn(|k| {
+            if k + 1 < VALUES {
+                grid.scale() * grid.direction(k)
+            } else {
+                DVec3::ZERO
+            }
+        });
+        // One envelope per pair of end valences.
+        let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut envelopes: Vec<SupportEnvelope> = Vec::new();
+        let envelope_of: Vec<u32> = prims
+            .iter()
+            .map(|e| {
+                *pairs
+                    .entry((e.val_a.to_bits(), e.val_b.to_bits()))
+                    .or_insert_with(|| {
+                        let lw = piece_log_weights(e.val_a, e.val_b, scale);
+                        envelopes.push(SupportEnvelope::new(&lw));
+                        envelopes.len() as u32 - 1
+                    })
+            })
             .collect();
-        let prim_table = |e: &Edge| {
-            let lw = edge_piece_log_weights(e, scale);
-            let mut t: Vec<f64> = dirs
-                .iter()
-                .map(|&g| edge_weighted_support(e, g, alpha, &lw))
+        // The leaf slots' tables about the origin: per direction the largest support,
+        // then one exponential per primitive and one logarithm.
+        let leaf_slot = |first: usize, count: usize| -> Table {
+            let supports: Vec<Table> = (first..first + count)
+                .map(|p| {
+                    let (e, env) = (&prims[p], &envelopes[envelope_of[p] as usize]);
+                    env.supports(e, &dirs, alpha)
+                })
                 .collect();
-            t.push(edge_weighted_support(e, DVec3::ZERO, alpha, &lw));
-            t
+            log_sum_exp(&supports)
         };
-        let wide = &set.bvh.wide;
-        let mut values = vec![0.0f32; wide.len() * ENTRIES * n];
-        // Each node's slots' tables about the origin, children first (depth-first
-        // layout: a child's index is above its parent's).
-        let mut about_origin: Vec<[Option<Vec<f64>>; 4]> = vec![Default::default(); wide.len()];
-        for i in (0..wide.len()).rev() {
-            let node = &wide[i];
-            let mut slots: [Option<Vec<f64>>; 4] = Default::default();
-            for (k, slot) in slots.iter_mut().enumerate() {
-                let count = node.count[k];
-                if count == EMPTY {
-                    continue;
+        let slot_tables: Vec<[Option<Table>; 4]> = wide
+            .par_iter()
+            .map(|node| {
+                std::array::from_fn(|k| {
+                    let count = node.count[k];
+                    (count != EMPTY && count > 0)
+                        .then(|| leaf_slot(node.child[k] as usize, count as usize))
+                })
+            })
+            .collect();
+        // Every inner slot's table about the origin, a level of the tree at a time,
+        // deepest first: the sum over its child's slots.
+        let mut depth = vec![0usize; wide.len()];
+        for (i, node) in wide.iter().enumerate() {
+            for k in 0..4 {
+                if node.count[k] == 0 {
+                    // Depth-first layout: a child's index is above its parent's.
+                    depth[node.child[k] as usize] = depth[i] + 1;
                 }
-                let mut t = vec![f64::NEG_INFINITY; n];
-                if count > 0 {
-                    let first = node.child[k] as usize;
-                    for e in &set.prims[first..first + count as usize] {
-                        for (a, b) in t.iter_mut().zip(prim_table(e)) {
-                            *a = lse(*a, b);
-                        }
-                    }
-                } else {
-                    for c in about_origin[node.child[k] as usize].iter().flatten() {
-                        for (a, b) in t.iter_mut().zip(c) {
-                            *a = lse(*a, *b);
-                        }
-                    }
-                }
-                *slot = Some(t);
             }
-            for e in 0..ENTRIES {
-                let t = if e < MIDDLE {
-                    slots[e].clone()
-                } else {
-                    let j = e - MIDDLE;
-                    match (&slots[2 * j], &slots[2 * j + 1]) {
-                        (Some(a), Some(b)) => {
-                            Some(a.iter().zip(b).map(|(x, y)| lse(*x, *y)).collect())
-                        }
-                        (Some(a), None) => Some(a.clone()),
-                        _ => None,
-                    }
-                };
-                let Some(t) = t else { continue };
-                let c = entry_centre(node, e);
-                let out = &mut values[(i * ENTRIES + e) * n..(i * ENTRIES + e + 1) * n];
-                for (k, o) in out.iter_mut().enumerate() {
-                    let shift = if k < dirs.len() {
-                        alpha * dirs[k].dot(c)
-                    } else {
-                        0.0
+        }
+        let mut levels: Vec<Vec<usize>> = vec![Vec::new(); depth.iter().max().map_or(0, |d| d + 1)];
+        for (i, &d) in depth.iter().enumerate() {
+            levels[d].push(i);
+        }
+        let mut total: Vec<Table> = vec![[f64::NEG_INFINITY; VALUES]; wide.len()];
+        let mut values = vec![0.0f32; wide.len() * ENTRIES * VALUES];
+        for level in levels.iter().rev() {
+            let done: Vec<(Box<[f32; ENTRIES * VALUES]>, Table)> = level
+                .par_iter()
+                .map(|&i| {
+                    let node = &wide[i];
+                    let slots: [Option<Table>; 4] = std::array::from_fn(|k| match node.count[k] {
+                        EMPTY => None,
+                        0 => Some(total[node.child[k] as usize]),
+                        _ => slot_tables[i][k],
+                    });
+                    let pair = |a: Option<Table>, b: Option<Table>| match (a, b) {
+                        (Some(a), Some(b)) => Some(std::array::from_fn(|d| lse(a[d], b[d]))),
+                        (a, None) => a,
+                        (None, b) => b,
                     };
-                    let v = t[k] - shift;
-                    // The subtraction's rounding, then f32 rounded up.
-                    let v = v + 1e-12 * (t[k].abs() + shift.abs() + 1.0);
-                    let f = v as f32;
-                    *o = if (f as f64) < v { f.next_up() } else { f };
-                }
+                    let middles = [pair(slots[0], slots[1]), pair(slots[2], slots[3])];
+                    let sum = pair(middles[0], middles[1]).unwrap_or([f64::NEG_INFINITY; VALUES]);
+                    // Each entry about its centre, rounded up to f32.
+                    let mut out = Box::new([0.0f32; ENTRIES * VALUES]);
+                    for e in 0..ENTRIES {
+                        let t = if e < MIDDLE {
+                            slots[e]
+                        } else {
+                            middles[e - MIDDLE]
+                        };
+                        let Some(t) = t else { continue };
+                        let c = entry_centre(node, e);
+                        let out = &mut out[e * VALUES..(e + 1) * VALUES];
+                        for ((o, &t), g) in out.iter_mut().zip(&t).zip(&dirs) {
+                            let shift = alpha * g.dot(c);
+                            let v = t - shift;
+                            // The subtraction's rounding, then f32 rounded up.
+                            let v = v + 1e-12 * (t.abs() + shift.abs() + 1.0);
+                            let f = v as f32;
+                            *o = if (f as f64) < v { f.next_up() } else { f };
+                        }
+                    }
+                    (out, sum)
+                })
+                .collect();
+            for (&i, (out, sum)) in level.iter().zip(done) {
+                values[i * ENTRIES * VALUES..(i + 1) * ENTRIES * VALUES].copy_from_slice(&*out);
+                total[i] = sum;
             }
-            about_origin[i] = slots;
         }
         DirectionalTables {
             grid,
             alpha,
+            q: scale.q,
             values,
         }
     }
@@ -155,12 +222,11 @@ impl DirectionalTables {
         if l.is_nan() || l == 0.0 {
             return None;
         }
-        let n = self.grid.len() + 1;
-        let t = &self.values[(i * ENTRIES + e) * n..(i * ENTRIES + e + 1) * n];
+        let t = &self.values[(i * ENTRIES + e) * VALUES..(i * ENTRIES + e + 1) * VALUES];
         let (idx, mu) = self.grid.cone(v / l);
         let s = self.grid.scale();
         let m: f64 = mu.iter().sum();
-        let mut d = (1.0 - m / s).max(0.0) * t[n - 1] as f64;
+        let mut d = (1.0 - m / s).max(0.0) * t[VALUES - 1] as f64;
         for k in 0..3 {
             d += mu[k] / s * t[idx[k]] as f64;
         }
@@ -173,6 +239,7 @@ mod tests {
     use super::*;
     use crate::bvh::BuildOptions;
     use crate::primitives::Primitive;
+    use crate::primitives::PrimitiveSet;
     use glam::Vec3;
 
     /// Every entry's bound is at least its primitives' exact sum, at points near and
@@ -200,7 +267,7 @@ mod tests {
         let set = PrimitiveSet::new(prims, 6.0, BuildOptions::default(), 0.0);
         for (alpha, max_alpha) in [(20.0, 40.0), (150.0, 100.0)] {
             let scale = WeightScale::new(set.max_adj, alpha, max_alpha);
-            let tables = DirectionalTables::for_edges(&set, alpha, &scale);
+            let tables = DirectionalTables::for_edges(&set.prims, &set.bvh.wide, alpha, &scale);
             for _ in 0..40 {
                 let x = DVec3::new(r() * 1.6 - 0.3, r() * 1.6 - 0.3, r() * 0.8 - 0.3);
                 for (i, node) in set.bvh.wide.iter().enumerate() {

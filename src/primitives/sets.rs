@@ -37,6 +37,10 @@ pub struct PrimitiveSet<P> {
     pub max_adj: f64,
     pub bounds: Aabb,
     pub times: BuildTimes,
+    /// Far-field tables that know directions and weights (`primitives::directional`;
+    /// edge sets of a rendered object, at its `alpha`), read by the walk where they
+    /// match its parameters.
+    pub directional: Option<std::sync::Arc<super::directional::DirectionalTables>>,
 }
 
 impl PrimitiveSet<Point> {
@@ -93,6 +97,7 @@ impl<P: Primitive> PrimitiveSet<P> {
                 primitives: prim_seconds,
                 bvh: t.elapsed().as_secs_f64(),
             },
+            directional: None,
         }
     }
 

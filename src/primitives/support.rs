@@ -23,7 +23,13 @@ pub const EDGE_PIECES: usize = 32;
 
 /// The largest `ln w` over each piece of `e` (computed once per edge).
 pub fn edge_piece_log_weights(e: &Edge, scale: &WeightScale) -> [f64; EDGE_PIECES] {
-    let c = edge_quartic(1.0 / e.val_a as f64, 1.0 / e.val_b as f64);
+    piece_log_weights(e.val_a, e.val_b, scale)
+}
+
+/// The largest `ln w` over each piece of an edge whose ends have valences `val_a` and
+/// `val_b` (the weight knows nothing else of the edge).
+pub fn piece_log_weights(val_a: f32, val_b: f32, scale: &WeightScale) -> [f64; EDGE_PIECES] {
+    let c = edge_quartic(1.0 / val_a as f64, 1.0 / val_b as f64);
     let w = |t: f64| edge_w(t, c).0;
     // The roots of W'(t) / t = 4 c4 t^2 + 3 c3 t + 2 c2.
     let (qa, qb, qc) = (4.0 * c[3], 3.0 * c[2], 2.0 * c[1]);
@@ -76,6 +82,104 @@ pub fn edge_weighted_support(
     best + 1e-12 * (ga.abs() + gd.abs() + 1.0)
 }
 
+/// [`edge_weighted_support`] for every edge of one pair of end valences, faster: with
+/// `s = alpha g . (b - a)` the support is `alpha g . a + H(s)`, `H(s) = max_k lw_k + s
+/// t_k` with `t_k` the end of piece `k` that lies farther along `s` (its far end for `s >=
+/// 0`, its near end below). Each half keeps only the lines that are largest somewhere on
+/// it: those of larger slope (in `|s|`) than the line largest at `s = 0`, and of those the
+/// upper hull.
+#[derive(Clone, Debug)]
+pub struct SupportEnvelope {
+    /// `(slope, intercept)` of the lines for `s >= 0`.
+    rising: Vec<(f64, f64)>,
+    /// The same for `s < 0`.
+    falling: Vec<(f64, f64)>,
+}
+
+impl SupportEnvelope {
+    /// The envelope of the pieces' log-weights ([`piece_log_weights`]).
+    pub fn new(log_weights: &[f64; EDGE_PIECES]) -> SupportEnvelope {
+        let t = |k: usize| k as f64 / EDGE_PIECES as f64;
+        let rising = (0..EDGE_PIECES).map(|k| (t(k + 1), log_weights[k]));
+        // For `s < 0` the lines in `-s` (slope `-t_k`), so that both halves are hulls
+        // over `[0, inf)`; flipped back below.
+        let falling = (0..EDGE_PIECES).map(|k| (-t(k), log_weights[k]));
+        SupportEnvelope {
+            rising: half_hull(rising.collect()),
+            falling: half_hull(falling.collect())
+                .into_iter()
+                .map(|(m, b)| (-m, b))
+                .collect(),
+        }
+    }
+
+    /// At least [`edge_weighted_support`] of `e` in direction `g` at sharpness `alpha`
+    /// (the same value up to rounding), for an edge of this envelope's valences.
+    pub fn support(&self, e: &Edge, g: DVec3, alpha: f64) -> f64 {
+        self.supports(e, &[g], alpha)[0]
+    }
+
+    /// [`SupportEnvelope::support`] in each of the directions `g` (written to run a line
+    /// at a time over all directions).
+    #[inline]
+    pub fn supports<const N: usize>(&self, e: &Edge, g: &[DVec3; N], alpha: f64) -> [f64; N] {
+        let a = e.a.as_dvec3();
+        let d = e.b.as_dvec3() - a;
+        let ga: [f64; N] = std::array::from_fn(|k| alpha * g[k].dot(a));
+        let gd: [f64; N] = std::array::from_fn(|k| alpha * g[k].dot(d));
+        // Both halves everywhere (no branch in the loops), then each direction's half.
+        let half = |lines: &[(f64, f64)]| {
+            let mut h = [f64::NEG_INFINITY; N];
+            for &(m, b) in lines {
+                for k in 0..N {
+                    let v = b + m * gd[k];
+                    h[k] = if v > h[k] { v } else { h[k] };
+                }
+            }
+            h
+        };
+        let (rising, falling) = (half(&self.rising), half(&self.falling));
+        let h: [f64; N] =
+            std::array::from_fn(|k| if gd[k] >= 0.0 { rising[k] } else { falling[k] });
+        // The products' rounding, relative to their size.
+        std::array::from_fn(|k| {
+            ga[k] + h[k] + 1e-12 * (ga[k].abs() + gd[k].abs() + h[k].abs() + 1.0)
+        })
+    }
+}
+
+/// The lines `(slope, intercept)` that are largest somewhere on `s >= 0`, slopes
+/// ascending: none of smaller slope than the largest at 0, then the upper hull. A line
+/// is dropped only when the others lie above it by more than rounding everywhere.
+fn half_hull(mut lines: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    lines.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
+    // The largest at 0 (the steepest of equal intercepts) and the steeper lines.
+    let top = lines.iter().enumerate().fold(
+        0,
+        |best, (k, l)| if l.1 >= lines[best].1 { k } else { best },
+    );
+    let mut hull: Vec<(f64, f64)> = Vec::new();
+    for &l in &lines[top..] {
+        // Of equal slopes the last (largest intercept) stays.
+        if hull.last().is_some_and(|h| h.0 == l.0) {
+            hull.pop();
+        }
+        // The middle of the last two is dropped when the outer two meet above it.
+        while hull.len() >= 2 {
+            let (p, q) = (hull[hull.len() - 2], hull[hull.len() - 1]);
+            let above = (l.1 - p.1) * (q.0 - p.0) - (q.1 - p.1) * (l.0 - p.0);
+            let tolerance = 1e-12 * (p.1.abs() + q.1.abs() + l.1.abs() + 1.0);
+            if above > tolerance {
+                hull.pop();
+            } else {
+                break;
+            }
+        }
+        hull.push(l);
+    }
+    hull
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -121,6 +225,48 @@ mod tests {
         assert!(
             worst_gap <= 1.0,
             "the bound runs {worst_gap} pieces' spread above"
+        );
+    }
+
+    /// The envelope gives the pieces' support, with fewer lines.
+    #[test]
+    fn the_envelope_matches_the_pieces() {
+        let mut seed = 29u64;
+        let mut r = move || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut lines = 0;
+        for case in 0..600 {
+            let mut v = || Vec3::new(r() as f32, r() as f32, r() as f32) * 2.0 - Vec3::ONE;
+            let e = Edge {
+                a: v(),
+                b: v(),
+                val_a: (1 + case % 12) as f32,
+                val_b: (1 + (case / 12) % 7) as f32,
+            };
+            let alpha = 1.0 + 300.0 * r();
+            let scale = WeightScale::new(12.0, alpha, 50.0 + 200.0 * r());
+            let lw = edge_piece_log_weights(&e, &scale);
+            let env = SupportEnvelope::new(&lw);
+            lines += env.rising.len() + env.falling.len();
+            for _ in 0..8 {
+                let g = DVec3::new(r() - 0.5, r() - 0.5, r() - 0.5) * 2.6;
+                let pieces = edge_weighted_support(&e, g, alpha, &lw);
+                let fast = env.support(&e, g, alpha);
+                let size = 1e-11 * (pieces.abs() + alpha * 4.0 + 1.0);
+                assert!(
+                    fast >= pieces && fast <= pieces + size,
+                    "case {case}: envelope {fast} against the pieces' {pieces}"
+                );
+            }
+        }
+        assert!(
+            lines < 600 * EDGE_PIECES,
+            "{lines} lines kept of {}",
+            1200 * EDGE_PIECES
         );
     }
 }

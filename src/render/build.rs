@@ -232,6 +232,13 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
             seconds: 0.0,
         });
         let mut object = TraceObject::new(sets, params);
+        if object.sets.iter().any(|s| matches!(s, AnySet::Edges(_))) {
+            steps.push(BuildStep {
+                object: k,
+                what: "edges: directional far-field tables".to_string(),
+                seconds: object.tables_seconds,
+            });
+        }
         object.signed = signed;
         object.colours = match obj.colour {
             Some(c) if c.by == GeometryColorBy::Normal => Some(ObjectColours {

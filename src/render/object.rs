@@ -5,8 +5,10 @@ use super::signed::SignedSurface;
 use crate::colour::ObjectColours;
 use crate::eval::{self, Along, EvalParams, FarShare, Sample};
 use crate::mesh::Aabb;
+use crate::primitives::directional::DirectionalTables;
 use crate::primitives::{AnySet, WeightScale};
 use glam::DVec3;
+use std::sync::Arc;
 
 /// The largest `alpha` times median edge length at which an object of triangles counts
 /// as soft (`TraceObject::soft_triangles`): there the tracer decides hits at a coarser
@@ -30,10 +32,29 @@ pub struct TraceObject {
     /// otherwise), measured once: what [`TraceObject::soft_triangles`] compares with
     /// `alpha` (the scene builder's server changes `alpha`, not the sets).
     triangle_edge: Option<f64>,
+    /// Seconds spent building its edge sets' directional far-field tables (0 without
+    /// edges), for the build report.
+    pub tables_seconds: f64,
 }
 
 impl TraceObject {
     pub fn new(sets: Vec<AnySet>, params: EvalParams) -> TraceObject {
+        // Edge sets get far-field tables at the object's own `alpha`
+        // (`primitives::directional`; the walk takes them where its parameters match).
+        let mut sets = sets;
+        let t = std::time::Instant::now();
+        for s in &mut sets {
+            if let AnySet::Edges(e) = s {
+                let scale = WeightScale::new(e.max_adj, params.alpha, params.max_alpha);
+                e.directional = Some(Arc::new(DirectionalTables::for_edges(
+                    &e.prims,
+                    &e.bvh.wide,
+                    params.alpha,
+                    &scale,
+                )));
+            }
+        }
+        let tables_seconds = t.elapsed().as_secs_f64();
         let bounds = sets.iter().fold(Aabb::EMPTY, |b, s| b.union(s.bounds()));
         let triangle_edge = sets
             .iter()
@@ -50,6 +71,7 @@ impl TraceObject {
             colours: None,
             signed: None,
             triangle_edge,
+            tables_seconds,
         }
     }
 

@@ -166,8 +166,14 @@ def test_value_bounds_bracket_the_exact_value(torus_mesh, rng, kind):
         slack = 1e-9 / approx.alpha + 1e-9 * np.abs(s0)
         assert (lo <= s0 + slack).all() and (s0 <= hi + slack).all()
         assert (hi - lo).max() > 1e-6 / approx.alpha  # beta 0.7 is not exact somewhere
-        if kind != "points":
-            np.testing.assert_array_equal(lo, approx.value(P))
+        v = approx.value(P)
+        assert (v <= s0 + slack).all()
+        if kind == "triangles":
+            np.testing.assert_array_equal(lo, v)
+        elif kind == "edges":
+            # The edges' far terms in `value` may also come from their directional
+            # tables, which the bounds do not read: `value` lies within the interval.
+            assert (lo <= v + slack).all()
         # At beta 0 the interval closes (up to the pruning, a share 1e-10 of the sum).
         lo0, hi0 = exact.value_bounds(P)
         assert ((hi0 - lo0) * exact.alpha < 1e-8).all()
