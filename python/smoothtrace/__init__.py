@@ -247,8 +247,7 @@ class SmoothDistance:
         """The smooth distance at each row of ``P`` with a certified interval around the
         exact (beta 0) value: ``(lower, upper)``, two (n,) float64 arrays with ``lower <=
         exact <= upper``. ``lower`` is the Barnes-Hut sum (as ``value`` gives it, but for
-        point clouds and edges, whose far terms here bound from the closest box, not from
-        moments or directional tables: there ``lower <= value``);
+        point clouds, whose far terms here bound from the closest box, not from moments);
         ``upper`` takes every far-field subtree at its lower bound. Their difference says
         how much ``beta`` costs in accuracy at each point."""
         return self._native.value_bounds(_coordinates(P, "P"), _threads(threads))

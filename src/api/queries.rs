@@ -131,9 +131,8 @@ pub fn values(object: &TraceObject, points: &[DVec3]) -> Vec<f64> {
 /// `(lower, upper)`, `lower` the value of [`values`] (the Barnes-Hut sum is a lower bound)
 /// and `upper` from the same walk with every far-field subtree at its lower bound (its
 /// farthest corner, weight 1; pruned ones at zero: `eval::smooth`, `s_upper`). Point
-/// clouds' far terms are then the closest box's rather than their moments, and edges'
-/// the closest box's rather than their directional tables', so `lower` may be below
-/// [`values`]' there.
+/// clouds' far terms are then the closest box's rather than their moments, so `lower`
+/// may be below [`values`]' there.
 pub fn value_bounds(object: &TraceObject, points: &[DVec3]) -> (Vec<f64>, Vec<f64>) {
     let sets = object.set_refs();
     let mut p = object.params;
@@ -255,7 +254,7 @@ mod tests {
     }
 
     /// `value_bounds` brackets the exact (brute-force) value on triangles, edges and
-    /// points at soft and stiff alphas and several betas, `values` lies within it on
+    /// points at soft and stiff alphas and several betas, its lower end is `values`' on
     /// meshes, and the interval closes as beta goes to 0.
     #[test]
     fn value_bounds_bracket_the_exact_value() {
@@ -290,13 +289,9 @@ mod tests {
                         let at = format!("{kind:?} alpha_rel {alpha_rel} beta {beta} at {x}");
                         assert!(lo[i] <= exact + slack, "{at}: lower {} > {exact}", lo[i]);
                         assert!(hi[i] >= exact - slack, "{at}: upper {} < {exact}", hi[i]);
-                        // `values` is a lower bound too, and on meshes at least the
-                        // bounds' lower end (the same walk; edges' far terms may also
-                        // come from their directional tables, which the bounds do not
-                        // read).
                         assert!(v[i] <= exact + slack, "{at}: value {} > {exact}", v[i]);
                         if kind != PrimitiveKind::Points {
-                            assert!(lo[i] <= v[i] + slack, "{at}: lower {} > {}", lo[i], v[i]);
+                            assert_eq!(lo[i], v[i], "{at}");
                         }
                         width = width.max(hi[i] - lo[i]);
                     }

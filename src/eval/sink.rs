@@ -123,9 +123,21 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
         } else {
             self.acc.add_value_far(r, weight);
         }
+        self.far_upper(x, weight, (min, max), other);
+    }
+
+    /// With `upper`, a far-field subtree's part of the upper bound: every primitive
+    /// below lies in the box (the union of a middle's two), within the distance of its
+    /// farthest corner, with a weight of at least 1 (`weight` is `n w_ff`).
+    #[inline]
+    fn far_upper(
+        &mut self,
+        x: DVec3,
+        weight: f64,
+        (min, max): (DVec3, DVec3),
+        other: Option<(DVec3, DVec3)>,
+    ) {
         if self.upper {
-            // Every primitive below lies in the box (the union of a middle's two), within
-            // the distance of its farthest corner, with a weight of at least 1.
             let (lo, hi) = other.map_or((min, max), |(a, b)| (min.min(a), max.max(b)));
             let far_corner = DVec3::select((x - 0.5 * (lo + hi)).cmpge(DVec3::ZERO), lo, hi);
             self.acc
@@ -176,9 +188,31 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
     /// (`primitives::directional`): `exp(-alpha d)` with `d = |x - c| - D / alpha` and
     /// `dir = (x - c) / |x - c|`. For the fixed direction the bound is linear in the
     /// query point, so its slope along the ray is `dir . u` and it holds all along.
+    /// Its part of the upper bound is the box's (`weight`, the box and `other` as in
+    /// [`Sink::far`]).
     #[inline]
-    pub fn far_directional(&mut self, d: f64, dir: DVec3) {
-        self.term(d, 1.0, dir);
+    pub fn far_directional(
+        &mut self,
+        x: DVec3,
+        d: f64,
+        dir: DVec3,
+        weight: f64,
+        bx: (DVec3, DVec3),
+        other: Option<(DVec3, DVec3)>,
+    ) {
+        let m = self.acc.m;
+        if GRAD {
+            let e = self.acc.add_far(d, 1.0, dir);
+            if SLOPE {
+                self.add_slope(m, e, dir.dot(self.u));
+            }
+        } else if SLOPE {
+            let e = self.acc.add_value_far(d, 1.0);
+            self.add_slope(m, e, dir.dot(self.u));
+        } else {
+            self.acc.add_value_far(d, 1.0);
+        }
+        self.far_upper(x, weight, bx, other);
     }
 
     /// A far-field term at distance `d` with unit direction `dir` (the gradient of `d`,

@@ -187,7 +187,7 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
             directional: set
                 .directional
                 .as_deref()
-                .filter(|t| p.moments && !p.upper_bound && t.alpha == p.alpha && t.q == scale.q),
+                .filter(|t| p.moments && t.alpha == p.alpha && t.q == scale.q),
             budget,
             ln2_over_alpha: std::f64::consts::LN_2 / p.alpha,
             alpha_log2e: p.alpha * std::f64::consts::LOG2_E,
@@ -448,7 +448,14 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
                     // `ln w`).
                     let alpha = t.alpha;
                     if d - alpha * l < ln_w - alpha * near.0.sqrt() {
-                        self.sink.far_directional(l - d / alpha, (self.x - c) / l);
+                        self.sink.far_directional(
+                            self.x,
+                            l - d / alpha,
+                            (self.x - c) / l,
+                            w,
+                            near.1,
+                            near.2,
+                        );
                         return;
                     }
                 }

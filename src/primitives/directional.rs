@@ -1,20 +1,24 @@
 //! Tables of a far-field bound that knows directions and weights, for the slots and
-//! middles of an edge set's wide tree (doc/performance-log.md, rounds twenty-eight and
-//! twenty-nine). A rendered object's edge sets carry them (`render::object`), and the
-//! walk takes the smaller of a far term's box bound and theirs (`eval::walk`).
+//! middles of an edge or triangle set's wide tree (doc/performance-log.md, rounds
+//! twenty-eight and twenty-nine). A rendered object's edge sets carry them
+//! (`render::object`; triangle sets not yet, round twenty-nine says why), and the walk
+//! takes the smaller of a far term's box bound and theirs (`eval::walk`), in the upper
+//! bound's walk too (its far terms' lower bounds stay the boxes').
 //!
 //! For an entry (slot or middle) with box centre `c` and the primitives `T` below it, and
 //! any unit `u`, each term is at most `exp(-alpha u . (x - c) + alpha s_T(u))` with `s_T`
-//! the weighted support about `c` (`primitives::support`), so the entry's terms sum to at
-//! most `exp(-alpha |x - c| + D(u))` for `u = (x - c) / |x - c|`, `D(u) = ln sum_T
+//! the weighted support about `c` (`primitives::support`,
+//! `primitives::triangle_support`), so the entry's terms sum to at most `exp(-alpha |x -
+//! c| + D(u))` for `u = (x - c) / |x - c|`, `D(u) = ln sum_T
 //! exp(alpha s_T(u))`. `D` is convex, and `geometry::directions` bounds it between its
 //! values at the grid's scaled directions and at 0, which the table holds (rounded up to
 //! f32). The values are summed about the origin up the tree by log-sum-exp and moved to
 //! each entry's centre at the end: `alpha s_T(v)` about `c` is the value about the origin
 //! minus `alpha v . c`.
 
-use super::kinds::Edge;
+use super::kinds::{Edge, Triangle};
 use super::support::{SupportEnvelope, piece_log_weights};
+use super::triangle_support::TriangleLattice;
 use super::weights::WeightScale;
 use crate::bvh::Node4;
 use crate::bvh::moments::MIDDLE;
@@ -92,21 +96,9 @@ pub fn entry_centre(node: &Node4, e: usize) -> DVec3 {
 }
 
 impl DirectionalTables {
-    /// The tables of `set` at sharpness `alpha` (weights by `scale`), on a
-    /// [`GRID`] x [`GRID`] grid. The leaves' slots are summed in parallel, then the
-    /// tree a level at a time, then the entries moved to their centres in parallel.
-    /// `prims` are the edges in the tree's order and `wide` its nodes.
+    /// The tables of an edge set at sharpness `alpha` (weights by `scale`): `prims` are
+    /// the edges in the tree's order and `wide` its nodes.
     pub fn for_edges(prims: &[Edge], wide: &[Node4], alpha: f64, scale: &WeightScale) -> Self {
-        use rayon::prelude::*;
-        let grid = DirectionGrid::new(GRID);
-        // The grid's scaled directions, then 0.
-        let dirs: [DVec3; VALUES] = std::array::from_fn(|k| {
-            if k + 1 < VALUES {
-                grid.scale() * grid.direction(k)
-            } else {
-                DVec3::ZERO
-            }
-        });
         // One envelope per pair of end valences.
         let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
         let mut envelopes: Vec<SupportEnvelope> = Vec::new();
@@ -122,16 +114,61 @@ impl DirectionalTables {
                     })
             })
             .collect();
+        Self::build(wide, alpha, scale, |p, dirs| {
+            envelopes[envelope_of[p] as usize].supports(&prims[p], dirs, alpha)
+        })
+    }
+
+    /// The tables of a triangle set, as [`DirectionalTables::for_edges`].
+    pub fn for_triangles(
+        prims: &[Triangle],
+        wide: &[Node4],
+        alpha: f64,
+        scale: &WeightScale,
+    ) -> Self {
+        // One lattice per pair of valences.
+        let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut lattices: Vec<TriangleLattice> = Vec::new();
+        let lattice_of: Vec<u32> = prims
+            .iter()
+            .map(|t| {
+                *pairs
+                    .entry((t.vmax.to_bits(), t.emax.to_bits()))
+                    .or_insert_with(|| {
+                        lattices.push(TriangleLattice::new(t.vmax, t.emax, scale));
+                        lattices.len() as u32 - 1
+                    })
+            })
+            .collect();
+        Self::build(wide, alpha, scale, |p, dirs| {
+            lattices[lattice_of[p] as usize].supports(&prims[p], dirs, alpha)
+        })
+    }
+
+    /// The tables from each primitive's weighted supports (`supports(p, dirs)` for
+    /// primitive `p` in the tree's order), on a [`GRID`] x [`GRID`] grid. The leaves'
+    /// slots are summed in parallel, then the tree a level at a time.
+    fn build(
+        wide: &[Node4],
+        alpha: f64,
+        scale: &WeightScale,
+        supports: impl Fn(usize, &[DVec3; VALUES]) -> Table + Sync,
+    ) -> Self {
+        use rayon::prelude::*;
+        let grid = DirectionGrid::new(GRID);
+        // The grid's scaled directions, then 0.
+        let dirs: [DVec3; VALUES] = std::array::from_fn(|k| {
+            if k + 1 < VALUES {
+                grid.scale() * grid.direction(k)
+            } else {
+                DVec3::ZERO
+            }
+        });
         // The leaf slots' tables about the origin: per direction the largest support,
         // then one exponential per primitive and one logarithm.
         let leaf_slot = |first: usize, count: usize| -> Table {
-            let supports: Vec<Table> = (first..first + count)
-                .map(|p| {
-                    let (e, env) = (&prims[p], &envelopes[envelope_of[p] as usize]);
-                    env.supports(e, &dirs, alpha)
-                })
-                .collect();
-            log_sum_exp(&supports)
+            let s: Vec<Table> = (first..first + count).map(|p| supports(p, &dirs)).collect();
+            log_sum_exp(&s)
         };
         let slot_tables: Vec<[Option<Table>; 4]> = wide
             .par_iter()
@@ -242,17 +279,20 @@ mod tests {
     use crate::primitives::PrimitiveSet;
     use glam::Vec3;
 
-    /// Every entry's bound is at least its primitives' exact sum, at points near and
-    /// far, on a random wireframe.
-    #[test]
-    fn every_entry_bounds_its_terms() {
-        let mut seed = 5u64;
-        let mut r = move || {
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
             seed = seed
                 .wrapping_mul(6_364_136_223_846_793_005)
                 .wrapping_add(1_442_695_040_888_963_407);
             (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        }
+    }
+
+    /// Every entry's bound is at least its primitives' exact sum, at points near and
+    /// far, on a random wireframe.
+    #[test]
+    fn every_entry_bounds_its_terms_on_edges() {
+        let mut r = uniform(5);
         let mut prims = Vec::new();
         for i in 0..600 {
             let a = Vec3::new(r() as f32, r() as f32, 0.2 * r() as f32);
@@ -265,9 +305,44 @@ mod tests {
             });
         }
         let set = PrimitiveSet::new(prims, 6.0, BuildOptions::default(), 0.0);
+        check_every_entry(&set, &mut r, |alpha, scale| {
+            DirectionalTables::for_edges(&set.prims, &set.bvh.wide, alpha, scale)
+        });
+    }
+
+    /// The same on a random triangle soup, valences 1 to 12 (the table's and beyond).
+    #[test]
+    fn every_entry_bounds_its_terms_on_triangles() {
+        let mut r = uniform(9);
+        let mut prims = Vec::new();
+        for i in 0..500 {
+            let a = Vec3::new(r() as f32, r() as f32, 0.2 * r() as f32);
+            let mut v = || Vec3::new(r() as f32 - 0.5, r() as f32 - 0.5, r() as f32 - 0.5) * 0.1;
+            let (b, c) = (a + v(), a + v());
+            prims.push(Triangle::new(
+                a,
+                b,
+                c,
+                (1 + i % 12) as f32,
+                (1 + i % 3) as f32,
+            ));
+        }
+        let set = PrimitiveSet::new(prims, 12.0, BuildOptions::default(), 0.0);
+        check_every_entry(&set, &mut r, |alpha, scale| {
+            DirectionalTables::for_triangles(&set.prims, &set.bvh.wide, alpha, scale)
+        });
+    }
+
+    /// At 40 random points and two `alpha`s, every entry of every node bounds the exact
+    /// sum of its primitives' terms.
+    fn check_every_entry<P: Primitive>(
+        set: &PrimitiveSet<P>,
+        r: &mut impl FnMut() -> f64,
+        tables: impl Fn(f64, &WeightScale) -> DirectionalTables,
+    ) {
         for (alpha, max_alpha) in [(20.0, 40.0), (150.0, 100.0)] {
             let scale = WeightScale::new(set.max_adj, alpha, max_alpha);
-            let tables = DirectionalTables::for_edges(&set.prims, &set.bvh.wide, alpha, &scale);
+            let tables = tables(alpha, &scale);
             for _ in 0..40 {
                 let x = DVec3::new(r() * 1.6 - 0.3, r() * 1.6 - 0.3, r() * 0.8 - 0.3);
                 for (i, node) in set.bvh.wide.iter().enumerate() {
@@ -277,7 +352,7 @@ mod tests {
                         } else {
                             vec![2 * (e - MIDDLE), 2 * (e - MIDDLE) + 1]
                         };
-                        let exact = exact_sum(&set, node, &slots, x, alpha, &scale);
+                        let exact = exact_sum(set, node, &slots, x, alpha, &scale);
                         if exact == 0.0 {
                             continue;
                         }
@@ -297,8 +372,8 @@ mod tests {
     }
 
     /// The exact sum of the terms below `slots` of `node`.
-    fn exact_sum(
-        set: &PrimitiveSet<Edge>,
+    fn exact_sum<P: Primitive>(
+        set: &PrimitiveSet<P>,
         node: &Node4,
         slots: &[usize],
         x: DVec3,

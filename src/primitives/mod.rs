@@ -1,6 +1,6 @@
 //! Primitive sets built from a mesh: points, edges, triangles (SPEC 1), their weights
-//! (SPEC 4, 5), an edge's weighted support and its tables over directions (`support`,
-//! `directional`) and their BVHs (SPEC 6).
+//! (SPEC 4, 5), the weighted supports of edges and triangles and their tables over
+//! directions (`support`, `triangle_support`, `directional`) and their BVHs (SPEC 6).
 
 use serde::Deserialize;
 
@@ -9,6 +9,7 @@ mod kinds;
 pub mod lanes;
 mod sets;
 pub mod support;
+pub mod triangle_support;
 pub mod weights;
 
 pub use kinds::{Edge, Point, Primitive, Slope, Term, Triangle};

@@ -39,22 +39,6 @@ pub struct TraceObject {
 
 impl TraceObject {
     pub fn new(sets: Vec<AnySet>, params: EvalParams) -> TraceObject {
-        // Edge sets get far-field tables at the object's own `alpha`
-        // (`primitives::directional`; the walk takes them where its parameters match).
-        let mut sets = sets;
-        let t = std::time::Instant::now();
-        for s in &mut sets {
-            if let AnySet::Edges(e) = s {
-                let scale = WeightScale::new(e.max_adj, params.alpha, params.max_alpha);
-                e.directional = Some(Arc::new(DirectionalTables::for_edges(
-                    &e.prims,
-                    &e.bvh.wide,
-                    params.alpha,
-                    &scale,
-                )));
-            }
-        }
-        let tables_seconds = t.elapsed().as_secs_f64();
         let bounds = sets.iter().fold(Aabb::EMPTY, |b, s| b.union(s.bounds()));
         let triangle_edge = sets
             .iter()
@@ -64,15 +48,50 @@ impl TraceObject {
             })
             .try_fold(0.0f64, |longest, e| e.map(|e| longest.max(e)))
             .filter(|_| !sets.is_empty());
-        TraceObject {
+        let mut object = TraceObject {
             sets,
             params,
             bounds,
             colours: None,
             signed: None,
             triangle_edge,
-            tables_seconds,
+            tables_seconds: 0.0,
+        };
+        object.tables_seconds = object.update_far_tables();
+        object
+    }
+
+    /// Gives its edge sets directional far-field tables at its own `alpha` and
+    /// `max_alpha` (`primitives::directional`; the walk takes them where its parameters
+    /// match), building only those that do not match yet: call it after changing
+    /// `params` (the scene builder's server does). Returns the seconds spent.
+    pub fn update_far_tables(&mut self) -> f64 {
+        let t = std::time::Instant::now();
+        let (alpha, max_alpha) = (self.params.alpha, self.params.max_alpha);
+        let current = |tables: &Option<Arc<DirectionalTables>>, scale: &WeightScale| {
+            tables
+                .as_ref()
+                .is_some_and(|t| t.alpha == alpha && t.q == scale.q)
+        };
+        for s in &mut self.sets {
+            match s {
+                AnySet::Edges(e) => {
+                    let scale = WeightScale::new(e.max_adj, alpha, max_alpha);
+                    if !current(&e.directional, &scale) {
+                        e.directional = Some(Arc::new(DirectionalTables::for_edges(
+                            &e.prims,
+                            &e.bvh.wide,
+                            alpha,
+                            &scale,
+                        )));
+                    }
+                }
+                // Triangles' tables (`DirectionalTables::for_triangles`) are not built
+                // yet: doc/performance-log.md, round twenty-nine, says why.
+                AnySet::Triangles(_) | AnySet::Points(_) => {}
+            }
         }
+        t.elapsed().as_secs_f64()
     }
 
     pub fn set_refs(&self) -> Vec<&AnySet> {

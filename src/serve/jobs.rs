@@ -168,6 +168,7 @@ impl Jobs {
                 p.max_alpha = max_alpha;
                 p.beta = scene.render.beta;
                 p.accumulation = scene.render.evaluation;
+                c.built.objects[k].update_far_tables();
                 if c.matcaps[k] != o.matcap {
                     c.built.shaders[k] = MatCap::from_spec(&o.matcap).map_err(|e| {
                         ServeError::BadRequest(format!("{name}: object[{k}].matcap: {e}"))
