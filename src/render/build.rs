@@ -232,10 +232,10 @@ pub fn build_scene(scene: &Scene) -> Result<BuiltScene, BuildError> {
             seconds: 0.0,
         });
         let mut object = TraceObject::new(sets, params);
-        if object.sets.iter().any(|s| matches!(s, AnySet::Edges(_))) {
+        if object.sets.iter().any(|s| !matches!(s, AnySet::Points(_))) {
             steps.push(BuildStep {
                 object: k,
-                what: "edges: directional far-field tables".to_string(),
+                what: "directional far-field tables".to_string(),
                 seconds: object.tables_seconds,
             });
         }

@@ -32,8 +32,8 @@ pub struct TraceObject {
     /// otherwise), measured once: what [`TraceObject::soft_triangles`] compares with
     /// `alpha` (the scene builder's server changes `alpha`, not the sets).
     triangle_edge: Option<f64>,
-    /// Seconds spent building its edge sets' directional far-field tables (0 without
-    /// edges), for the build report.
+    /// Seconds spent building its edge and triangle sets' directional far-field tables
+    /// (0 for points), for the build report.
     pub tables_seconds: f64,
 }
 
@@ -61,10 +61,10 @@ impl TraceObject {
         object
     }
 
-    /// Gives its edge sets directional far-field tables at its own `alpha` and
-    /// `max_alpha` (`primitives::directional`; the walk takes them where its parameters
-    /// match), building only those that do not match yet: call it after changing
-    /// `params` (the scene builder's server does). Returns the seconds spent.
+    /// Gives its edge and triangle sets directional far-field tables at its own `alpha`
+    /// and `max_alpha` (`primitives::directional`; the walk takes them where its
+    /// parameters match), building only those that do not match yet: call it after
+    /// changing `params` (the scene builder's server does). Returns the seconds spent.
     pub fn update_far_tables(&mut self) -> f64 {
         let t = std::time::Instant::now();
         let (alpha, max_alpha) = (self.params.alpha, self.params.max_alpha);
@@ -86,9 +86,18 @@ impl TraceObject {
                         )));
                     }
                 }
-                // Triangles' tables (`DirectionalTables::for_triangles`) are not built
-                // yet: doc/performance-log.md, round twenty-nine, says why.
-                AnySet::Triangles(_) | AnySet::Points(_) => {}
+                AnySet::Triangles(t) => {
+                    let scale = WeightScale::new(t.max_adj, alpha, max_alpha);
+                    if !current(&t.directional, &scale) {
+                        t.directional = Some(Arc::new(DirectionalTables::for_triangles(
+                            &t.prims,
+                            &t.bvh.wide,
+                            alpha,
+                            &scale,
+                        )));
+                    }
+                }
+                AnySet::Points(_) => {}
             }
         }
         t.elapsed().as_secs_f64()

@@ -37,7 +37,9 @@ pub struct TracerOptions {
     pub hit_beta_scale: f64,
     /// The same for soft fields over triangle meshes (`TraceObject::soft_triangles`):
     /// many triangles within the kernel's width, where a coarser beta keeps the hits as
-    /// close to the exact surface (doc/performance-log.md, round twenty-one).
+    /// close to the exact surface (doc/performance-log.md, round twenty-one; 0.7 until
+    /// round twenty-nine gave triangles the directional far field). Not with certified
+    /// hits, which start from `hit_beta_scale`.
     pub hit_beta_scale_soft_triangles: f64,
     /// Evaluations at the hit beta on edges and triangles also take a subtree as one
     /// far-field term when its bound is at most this share of the sum
@@ -106,7 +108,7 @@ impl TracerOptions {
             neighbours: true,
             relax: true,
             hit_beta_scale: 0.6,
-            hit_beta_scale_soft_triangles: 0.7,
+            hit_beta_scale_soft_triangles: 0.8,
             far_share: FAR_SHARE,
             step_beta: 1.0,
             learn_step_beta: true,

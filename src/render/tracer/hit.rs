@@ -34,6 +34,12 @@ pub(super) const FINAL_REACH: f64 = 2.0;
 /// item 13),
 pub(super) const BAND_REACH_MAX: f64 = 8.0;
 
+/// The same on soft triangle meshes (`TraceObject::soft_triangles`), whose hits are
+/// decided at a coarser beta with the directional far field: from 8 epsilons out the
+/// landings missed by up to 3 epsilons on more of their rays (doc/performance-log.md,
+/// round twenty-nine).
+pub(super) const BAND_REACH_MAX_SOFT_TRIANGLES: f64 = 6.0;
+
 /// where its final step is predicted to end at most this many epsilons above zero
 /// (first order, from the gradient),
 const BAND_REACH_LAND: f64 = 0.25;
@@ -71,14 +77,16 @@ impl Tracer<'_> {
     }
 
     /// Whether the sample `f`, above the hit band, is the hit all the same (module docs,
-    /// item 13): on an object that takes such hits, within [`BAND_REACH_MAX`] epsilons,
+    /// item 13): on an object that takes such hits, within [`BAND_REACH_MAX`] epsilons
+    /// ([`BAND_REACH_MAX_SOFT_TRIANGLES`] on soft triangle meshes),
     /// with the gradient, where the field falls along the ray at least
     /// [`BAND_REACH_MIN_FALL`] and its final step (`s`, or the free distance up to
     /// [`FINAL_REACH`] `s`) ends, to first order, within [`BAND_REACH_LAND`] epsilons
     /// of zero.
     pub(super) fn lands_in_band(&self, f: &FieldSample, d: DVec3) -> bool {
         let eps = self.options.epsilon;
-        if !self.band_reach[f.object] || f.s <= eps || f.s > BAND_REACH_MAX * eps {
+        let most = self.band_reach[f.object];
+        if most == 0.0 || f.s <= eps || f.s > most * eps {
             return false;
         }
         let Some(g) = f.grad else {

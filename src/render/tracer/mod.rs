@@ -252,8 +252,9 @@ pub struct Tracer<'a> {
     weighted: Vec<bool>,
     /// Per object: its steps near the surface are aimed at the crossing (item 12).
     aims: Vec<bool>,
-    /// Per object: a sample just above the hit band may be the hit (item 13).
-    band_reach: Vec<bool>,
+    /// Per object: a sample this many epsilons above the hit band, or fewer, may be the
+    /// hit (item 13; 0: none).
+    band_reach: Vec<f64>,
     /// Union of the grown object boxes.
     min: DVec3,
     max: DVec3,
@@ -283,9 +284,11 @@ impl<'a> Tracer<'a> {
             .iter()
             .zip(&points_only)
             .map(|(o, &points)| {
+                // Certified hits start from the meshes' hit beta on soft triangles too:
+                // their halvings reach the exact sum from there (item 11).
                 let scale = if points {
                     1.0
-                } else if o.soft_triangles() {
+                } else if o.soft_triangles() && !options.certified_hits {
                     options.hit_beta_scale_soft_triangles
                 } else {
                     options.hit_beta_scale
@@ -336,19 +339,25 @@ impl<'a> Tracer<'a> {
             .map(|(&points, &narrow)| options.aim && options.reach_steps && points && narrow)
             .collect();
         // Hits from above the band on narrow edges and triangles whose hits are decided
-        // at the hit beta (`sticky`; item 13).
+        // at the hit beta (`sticky`; item 13), from at most this many epsilons above it
+        // (0: none).
         let band_reach = points_only
             .iter()
             .zip(&narrow)
             .zip(objects.iter().zip(&hit_beta))
             .map(|((&points, &narrow), (o, &h))| {
-                options.band_reach
+                let on = options.band_reach
                     && !options.certified_hits
                     && options.final_step
                     && options.reach_steps
                     && !points
                     && narrow
-                    && h < o.params.beta
+                    && h < o.params.beta;
+                match (on, o.soft_triangles()) {
+                    (false, _) => 0.0,
+                    (true, true) => hit::BAND_REACH_MAX_SOFT_TRIANGLES,
+                    (true, false) => hit::BAND_REACH_MAX,
+                }
             })
             .collect();
         let refine = step_beta.iter().zip(&hit_beta).any(|(s, h)| s != h);
