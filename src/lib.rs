@@ -33,4 +33,6 @@ pub mod reports;
 pub mod rgb;
 pub mod scene;
 pub mod serve;
+#[cfg(test)]
+pub(crate) mod testing;
 pub mod winding;

@@ -626,8 +626,8 @@ fn write_stats_json(
 }
 
 /// Seconds per phase: loading meshes (the build log's `mesh` steps), building the rest
-/// (primitive sets, BVHs, far-field tables, colours, MatCaps), tracing (wall clock of the image loop,
-/// shading included) and shading alone (CPU seconds summed over the threads).
+/// (primitive sets, BVHs, far-field tables, colours, MatCaps), tracing (wall clock of the
+/// image loop, shading included) and shading alone (CPU seconds summed over the threads).
 fn phases(st: &ImageStats, built: &BuiltScene) -> serde_json::Value {
     let load: f64 = built
         .steps

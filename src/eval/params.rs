@@ -72,9 +72,9 @@ pub struct EvalParams {
     /// within `2 prune_tolerance / alpha` of it.
     pub prune_tolerance: f64,
     /// Far-field terms of point clouds from the subtree's second moments (module docs),
-    /// and edge sets' from their directional tables where they carry them for this
-    /// `alpha` (`primitives::directional`); default on. Off, every far-field term is the
-    /// closest-box one (the paper's).
+    /// and edge and triangle sets' from their directional tables where they carry them
+    /// for this `alpha` (`primitives::directional`); default on. Off, every far-field
+    /// term is the closest-box one (the paper's).
     pub moments: bool,
     /// Also bound the exact value from above (`Sample::s_upper`; far-field subtrees at
     /// their lower bounds): one more exponential per far-field term, and point clouds'

@@ -53,7 +53,8 @@ pub(super) struct Walk<'w, 'a, P, const GRAD: bool, const SLOPE: bool, const SHA
     /// Second moments per wide node, when far fields use them (points).
     moments: &'w [Moments4],
     /// Directional tables, where the set has them for this `alpha` and `q` and far
-    /// fields may be tighter than the closest box (edges of a rendered object).
+    /// fields may be tighter than the closest box (edges and triangles of a rendered
+    /// object).
     directional: Option<&'w DirectionalTables>,
     /// Share of the sum that subtrees pruned against the budget may hold together (0 =
     /// off; `eval::smooth` module docs).

@@ -1,9 +1,9 @@
 //! Tables of a far-field bound that knows directions and weights, for the slots and
 //! middles of an edge or triangle set's wide tree (doc/performance-log.md, rounds
-//! twenty-eight and twenty-nine). A rendered object's edge sets carry them
-//! (`render::object`; triangle sets not yet, round twenty-nine says why), and the walk
-//! takes the smaller of a far term's box bound and theirs (`eval::walk`), in the upper
-//! bound's walk too (its far terms' lower bounds stay the boxes').
+//! twenty-eight and twenty-nine). A rendered object's edge and triangle sets carry them
+//! (`render::object`), and the walk takes the smaller of a far term's box bound and
+//! theirs (`eval::walk`), in the upper bound's walk too (its far terms' lower bounds stay
+//! the boxes').
 //!
 //! For an entry (slot or middle) with box centre `c` and the primitives `T` below it, and
 //! any unit `u`, each term is at most `exp(-alpha u . (x - c) + alpha s_T(u))` with `s_T`
@@ -67,6 +67,28 @@ fn log_sum_exp(tables: &[Table]) -> Table {
     })
 }
 
+/// One `T` per distinct pair of valences (`valences(p)`) among `prims`, made by `make`
+/// from the first primitive with that pair, and each primitive's index into them.
+fn per_valence_pair<P, T>(
+    prims: &[P],
+    valences: impl Fn(&P) -> (f32, f32),
+    make: impl Fn(&P) -> T,
+) -> (Vec<T>, Vec<u32>) {
+    let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut made = Vec::new();
+    let index = prims
+        .iter()
+        .map(|p| {
+            let (a, b) = valences(p);
+            *pairs.entry((a.to_bits(), b.to_bits())).or_insert_with(|| {
+                made.push(make(p));
+                made.len() as u32 - 1
+            })
+        })
+        .collect();
+    (made, index)
+}
+
 /// `ln(e^a + e^b)`, exact for infinities.
 pub fn lse(a: f64, b: f64) -> f64 {
     let m = a.max(b);
@@ -100,20 +122,11 @@ impl DirectionalTables {
     /// the edges in the tree's order and `wide` its nodes.
     pub fn for_edges(prims: &[Edge], wide: &[Node4], alpha: f64, scale: &WeightScale) -> Self {
         // One envelope per pair of end valences.
-        let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut envelopes: Vec<SupportEnvelope> = Vec::new();
-        let envelope_of: Vec<u32> = prims
-            .iter()
-            .map(|e| {
-                *pairs
-                    .entry((e.val_a.to_bits(), e.val_b.to_bits()))
-                    .or_insert_with(|| {
-                        let lw = piece_log_weights(e.val_a, e.val_b, scale);
-                        envelopes.push(SupportEnvelope::new(&lw));
-                        envelopes.len() as u32 - 1
-                    })
-            })
-            .collect();
+        let (envelopes, envelope_of) = per_valence_pair(
+            prims,
+            |e| (e.val_a, e.val_b),
+            |e| SupportEnvelope::new(&piece_log_weights(e.val_a, e.val_b, scale)),
+        );
         Self::build(wide, alpha, scale, |p, dirs| {
             envelopes[envelope_of[p] as usize].supports(&prims[p], dirs, alpha)
         })
@@ -126,20 +139,11 @@ impl DirectionalTables {
         alpha: f64,
         scale: &WeightScale,
     ) -> Self {
-        // One lattice per pair of valences.
-        let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut lattices: Vec<TriangleLattice> = Vec::new();
-        let lattice_of: Vec<u32> = prims
-            .iter()
-            .map(|t| {
-                *pairs
-                    .entry((t.vmax.to_bits(), t.emax.to_bits()))
-                    .or_insert_with(|| {
-                        lattices.push(TriangleLattice::new(t.vmax, t.emax, scale));
-                        lattices.len() as u32 - 1
-                    })
-            })
-            .collect();
+        let (lattices, lattice_of) = per_valence_pair(
+            prims,
+            |t| (t.vmax, t.emax),
+            |t| TriangleLattice::new(t.vmax, t.emax, scale),
+        );
         Self::build(wide, alpha, scale, |p, dirs| {
             lattices[lattice_of[p] as usize].supports(&prims[p], dirs, alpha)
         })
@@ -277,16 +281,8 @@ mod tests {
     use crate::bvh::BuildOptions;
     use crate::primitives::Primitive;
     use crate::primitives::PrimitiveSet;
+    use crate::testing::uniform;
     use glam::Vec3;
-
-    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
-        move || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
 
     /// Every entry's bound is at least its primitives' exact sum, at points near and
     /// far, on a random wireframe.

@@ -38,8 +38,8 @@ pub struct PrimitiveSet<P> {
     pub bounds: Aabb,
     pub times: BuildTimes,
     /// Far-field tables that know directions and weights (`primitives::directional`;
-    /// edge sets of a rendered object, at its `alpha`), read by the walk where they
-    /// match its parameters.
+    /// edge and triangle sets of a rendered object, at its `alpha`), read by the walk
+    /// where they match its parameters.
     pub directional: Option<std::sync::Arc<super::directional::DirectionalTables>>,
 }
 

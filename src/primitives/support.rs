@@ -183,26 +183,26 @@ fn half_hull(mut lines: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testing::uniform;
     use glam::Vec3;
+
+    /// An edge with ends in the cube `[-1, 1]^3` and valences 1-12 and 1-7 by `case`.
+    fn random_edge(r: &mut impl FnMut() -> f64, case: usize) -> Edge {
+        let mut v = || Vec3::new(r() as f32, r() as f32, r() as f32) * 2.0 - Vec3::ONE;
+        Edge {
+            a: v(),
+            b: v(),
+            val_a: (1 + case % 12) as f32,
+            val_b: (1 + (case / 12) % 7) as f32,
+        }
+    }
 
     #[test]
     fn the_bound_covers_every_point_and_stays_close() {
-        let mut seed = 17u64;
-        let mut r = move || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut r = uniform(17);
         let mut worst_gap: f64 = 0.0;
         for case in 0..400 {
-            let mut v = || Vec3::new(r() as f32, r() as f32, r() as f32) * 2.0 - Vec3::ONE;
-            let e = Edge {
-                a: v(),
-                b: v(),
-                val_a: (1 + case % 12) as f32,
-                val_b: (1 + (case / 12) % 7) as f32,
-            };
+            let e = random_edge(&mut r, case);
             let (max_adj, alpha) = (12.0, 1.0 + 200.0 * r());
             let scale = WeightScale::new(max_adj, alpha, 100.0 + 200.0 * r());
             let lw = edge_piece_log_weights(&e, &scale);
@@ -231,22 +231,10 @@ mod tests {
     /// The envelope gives the pieces' support, with fewer lines.
     #[test]
     fn the_envelope_matches_the_pieces() {
-        let mut seed = 29u64;
-        let mut r = move || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut r = uniform(29);
         let mut lines = 0;
         for case in 0..600 {
-            let mut v = || Vec3::new(r() as f32, r() as f32, r() as f32) * 2.0 - Vec3::ONE;
-            let e = Edge {
-                a: v(),
-                b: v(),
-                val_a: (1 + case % 12) as f32,
-                val_b: (1 + (case / 12) % 7) as f32,
-            };
+            let e = random_edge(&mut r, case);
             let alpha = 1.0 + 300.0 * r();
             let scale = WeightScale::new(12.0, alpha, 50.0 + 200.0 * r());
             let lw = edge_piece_log_weights(&e, &scale);

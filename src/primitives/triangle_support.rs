@@ -208,16 +208,8 @@ impl TriangleLattice {
 mod tests {
     use super::*;
     use crate::primitives::weights::triangle_w_value;
+    use crate::testing::uniform;
     use glam::Vec3;
-
-    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
-        move || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
 
     /// The Bernstein coefficients rebuild the weight: at random points of each
     /// sub-triangle the Bernstein sum equals `triangle_w_value`.

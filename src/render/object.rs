@@ -2,11 +2,12 @@
 //! (SPEC 2), with its evaluation parameters and the bound of where its surface can be.
 
 use super::signed::SignedSurface;
+use crate::bvh::Node4;
 use crate::colour::ObjectColours;
 use crate::eval::{self, Along, EvalParams, FarShare, Sample};
 use crate::mesh::Aabb;
 use crate::primitives::directional::DirectionalTables;
-use crate::primitives::{AnySet, WeightScale};
+use crate::primitives::{AnySet, Primitive, PrimitiveSet, WeightScale};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -15,6 +16,24 @@ use std::sync::Arc;
 /// beta (`TracerOptions::hit_beta_scale_soft_triangles`; doc/performance-log.md, round
 /// twenty-one).
 pub const SOFT_MAX_ALPHA_EDGE: f64 = 3.0;
+
+/// Gives `set` directional tables at `alpha` and `max_alpha` by `build`, unless it has
+/// them already.
+fn refresh<P: Primitive>(
+    set: &mut PrimitiveSet<P>,
+    alpha: f64,
+    max_alpha: f64,
+    build: impl Fn(&[P], &[Node4], f64, &WeightScale) -> DirectionalTables,
+) {
+    let scale = WeightScale::new(set.max_adj, alpha, max_alpha);
+    let current = set
+        .directional
+        .as_ref()
+        .is_some_and(|t| t.alpha == alpha && t.q == scale.q);
+    if !current {
+        set.directional = Some(Arc::new(build(&set.prims, &set.bvh.wide, alpha, &scale)));
+    }
+}
 
 /// Primitive sets summed into one smooth distance, evaluated with `params`.
 pub struct TraceObject {
@@ -68,34 +87,11 @@ impl TraceObject {
     pub fn update_far_tables(&mut self) -> f64 {
         let t = std::time::Instant::now();
         let (alpha, max_alpha) = (self.params.alpha, self.params.max_alpha);
-        let current = |tables: &Option<Arc<DirectionalTables>>, scale: &WeightScale| {
-            tables
-                .as_ref()
-                .is_some_and(|t| t.alpha == alpha && t.q == scale.q)
-        };
         for s in &mut self.sets {
             match s {
-                AnySet::Edges(e) => {
-                    let scale = WeightScale::new(e.max_adj, alpha, max_alpha);
-                    if !current(&e.directional, &scale) {
-                        e.directional = Some(Arc::new(DirectionalTables::for_edges(
-                            &e.prims,
-                            &e.bvh.wide,
-                            alpha,
-                            &scale,
-                        )));
-                    }
-                }
+                AnySet::Edges(e) => refresh(e, alpha, max_alpha, DirectionalTables::for_edges),
                 AnySet::Triangles(t) => {
-                    let scale = WeightScale::new(t.max_adj, alpha, max_alpha);
-                    if !current(&t.directional, &scale) {
-                        t.directional = Some(Arc::new(DirectionalTables::for_triangles(
-                            &t.prims,
-                            &t.bvh.wide,
-                            alpha,
-                            &scale,
-                        )));
-                    }
+                    refresh(t, alpha, max_alpha, DirectionalTables::for_triangles)
                 }
                 AnySet::Points(_) => {}
             }

@@ -71,10 +71,10 @@
 //!    returns to the plain step; a sample's free distance ahead, when longer, is the
 //!    step. Same surface, fewer steps at grazing incidence.
 //! 9. Hits are decided at a finer beta (`TracerOptions::hit_beta_scale` times the
-//!    scene's, 0.6 by default; 0.7, `hit_beta_scale_soft_triangles`, for soft fields
-//!    over triangle meshes, `TraceObject::soft_triangles`, where it keeps the hits
-//!    within the accuracy goals with a fifth fewer leaves: doc/performance-log.md, round
-//!    twenty-one): the Barnes-Hut sum is a lower bound of the exact one,
+//!    scene's, 0.6 by default; 0.8, `hit_beta_scale_soft_triangles`, for soft fields
+//!    over triangle meshes, `TraceObject::soft_triangles`, where with the directional
+//!    far field it keeps the hits within the accuracy goals with a quarter fewer leaves:
+//!    doc/performance-log.md, rounds twenty-one and twenty-nine): the Barnes-Hut sum is a lower bound of the exact one,
 //!    but where `alpha` times the size of far-field nodes is large (soft point clouds,
 //!    dense edge meshes at small `alpha`) it can be many epsilons low, and a ray that
 //!    stops where it drops below epsilon stops short of the exact surface. Evaluations
@@ -143,24 +143,24 @@
 //!     taken; on edges and triangles the weights' change along the ray makes the
 //!     tangent overshoot (more backtracks and rejected steps than evaluations spared, on
 //!     four meshes).
-//! 13. On edges and triangles whose hit band is narrow against the kernel (`alpha
-//!     epsilon < 0.4`, hits at the hit beta), a sample at the hit beta a few epsilons
-//!     above the band (at most [`BAND_REACH_MAX`](hit::BAND_REACH_MAX)), with the
-//!     gradient, is the hit when its final step (item 4: `s`, or the free distance up to
-//!     `2 s`) is predicted to end within a quarter epsilon of zero: `s - k L + max(c, 0)
-//!     L^2 / 2 <= epsilon / 4` for the step `L`, `k >= 0.1` the field's fall along the
-//!     ray (from the gradient) and `c` its bend (item 12's estimate, counted only where
-//!     it lifts the field). The step is the final step's, as certain as it is, so the
-//!     hit stays in front of the surface; only its landing in the band is predicted,
-//!     and the evaluation that would confirm it is spared. Near these surfaces the field
-//!     falls slowly along the ray (`k` of 0.2-0.8) and the free distance lands a few
-//!     epsilons short of the band, so most rays took one more fine evaluation there:
-//!     2-24% fewer full evaluations per hit ray on the soft cells of the speed matrix,
-//!     the hits' 99th percentile depth error against the exact surface up to half an
-//!     epsilon larger (doc/performance-log.md, round twenty-seven). Without the
-//!     bend, a ray skimming a thin tube of the hex torus took a hit where the field
-//!     rises again and the ray passes by. Off in the paper's mode, with certified hits
-//!     (item 11), and in the speed matrix's exact reference (`TracerOptions::band_reach`).
+//! 13. On edges and triangles whose hit band is narrow against the kernel (`alpha epsilon <
+//!     0.4`, hits at the hit beta), a sample at the hit beta a few epsilons above the band
+//!     (at most [`BAND_REACH_MAX`](hit::BAND_REACH_MAX), 6 on soft triangle meshes), with
+//!     the gradient, is the hit when its final step (item 4: `s`, or the free distance up
+//!     to `2 s`) is predicted to end within a quarter epsilon of zero: `s - k L + max(c, 0)
+//!     L^2 / 2 <= epsilon / 4` for the step `L`, `k >= 0.1` the field's fall along the ray
+//!     (from the gradient) and `c` its bend (item 12's estimate, counted only where it
+//!     lifts the field). The step is the final step's, as certain as it is, so the hit
+//!     stays in front of the surface; only its landing in the band is predicted, and the
+//!     evaluation that would confirm it is spared. Near these surfaces the field falls
+//!     slowly along the ray (`k` of 0.2-0.8) and the free distance lands a few epsilons
+//!     short of the band, so most rays took one more fine evaluation there: 2-24% fewer
+//!     full evaluations per hit ray on the soft cells of the speed matrix, the hits' 99th
+//!     percentile depth error against the exact surface up to half an epsilon larger
+//!     (doc/performance-log.md, round twenty-seven). Without the bend, a ray skimming a
+//!     thin tube of the hex torus took a hit where the field rises again and the ray passes
+//!     by. Off in the paper's mode, with certified hits (item 11), and in the speed
+//!     matrix's exact reference (`TracerOptions::band_reach`).
 
 mod hit;
 mod ray;
