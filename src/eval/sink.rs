@@ -177,7 +177,7 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
             // ln f <= f - 1: where `f - 1 <= alpha (l - r)` the moment term is the smaller.
             let reach = l - (f - 1.0) / alpha;
             if reach >= 0.0 && reach * reach >= r2 {
-                self.term(l, weight * f, u);
+                self.far_term(l, weight * f, u);
                 return;
             }
         }
@@ -200,36 +200,26 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
         bx: (DVec3, DVec3),
         other: Option<(DVec3, DVec3)>,
     ) {
-        let m = self.acc.m;
-        if GRAD {
-            let e = self.acc.add_far(d, 1.0, dir);
-            if SLOPE {
-                self.add_slope(m, e, dir.dot(self.u));
-            }
-        } else if SLOPE {
-            let e = self.acc.add_value_far(d, 1.0);
-            self.add_slope(m, e, dir.dot(self.u));
-        } else {
-            self.acc.add_value_far(d, 1.0);
-        }
+        self.far_term(d, 1.0, dir);
         self.far_upper(x, weight, bx, other);
     }
 
-    /// A far-field term at distance `d` with unit direction `dir` (the gradient of `d`,
+    /// A far-field term (an upper bound of its subtree's terms, not part of the exact
+    /// sum's lower end) at distance `d` with unit direction `dir` (the gradient of `d`,
     /// and its slope along the ray is `dir . u` exactly).
     #[inline]
-    fn term(&mut self, d: f64, weight: f64, dir: DVec3) {
+    fn far_term(&mut self, d: f64, weight: f64, dir: DVec3) {
         let m = self.acc.m;
         if GRAD {
-            let e = self.acc.add(d, weight, dir, DVec3::ZERO);
+            let e = self.acc.add_far(d, weight, dir);
             if SLOPE {
                 self.add_slope(m, e, dir.dot(self.u));
             }
         } else if SLOPE {
-            let e = self.acc.add_value(d, weight);
+            let e = self.acc.add_value_far(d, weight);
             self.add_slope(m, e, dir.dot(self.u));
         } else {
-            self.acc.add_value(d, weight);
+            self.acc.add_value_far(d, weight);
         }
     }
 

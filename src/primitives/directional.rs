@@ -284,6 +284,16 @@ mod tests {
     use crate::testing::uniform;
     use glam::Vec3;
 
+    /// A random point of the slab `[0, 1]^2 x [0, 0.2]`.
+    fn anchor(r: &mut impl FnMut() -> f64) -> Vec3 {
+        Vec3::new(r() as f32, r() as f32, 0.2 * r() as f32)
+    }
+
+    /// A random offset within 0.05 in each coordinate.
+    fn offset(r: &mut impl FnMut() -> f64) -> Vec3 {
+        Vec3::new(r() as f32 - 0.5, r() as f32 - 0.5, r() as f32 - 0.5) * 0.1
+    }
+
     /// Every entry's bound is at least its primitives' exact sum, at points near and
     /// far, on a random wireframe.
     #[test]
@@ -291,8 +301,8 @@ mod tests {
         let mut r = uniform(5);
         let mut prims = Vec::new();
         for i in 0..600 {
-            let a = Vec3::new(r() as f32, r() as f32, 0.2 * r() as f32);
-            let b = a + Vec3::new(r() as f32 - 0.5, r() as f32 - 0.5, r() as f32 - 0.5) * 0.1;
+            let a = anchor(&mut r);
+            let b = a + offset(&mut r);
             prims.push(Edge {
                 a,
                 b,
@@ -312,9 +322,8 @@ mod tests {
         let mut r = uniform(9);
         let mut prims = Vec::new();
         for i in 0..500 {
-            let a = Vec3::new(r() as f32, r() as f32, 0.2 * r() as f32);
-            let mut v = || Vec3::new(r() as f32 - 0.5, r() as f32 - 0.5, r() as f32 - 0.5) * 0.1;
-            let (b, c) = (a + v(), a + v());
+            let a = anchor(&mut r);
+            let (b, c) = (a + offset(&mut r), a + offset(&mut r));
             prims.push(Triangle::new(
                 a,
                 b,
