@@ -182,8 +182,12 @@ impl TraceObject {
         p.prune_tolerance = p.prune_tolerance.max(prune_tolerance);
         // Bound steps take closest-box far fields: both are lower bounds of the sum, so
         // either keeps a bound step safe, and the tighter moment terms buy no longer steps
-        // there for their extra cost (performance log, round four).
-        p.moments &= !bound;
+        // there for their extra cost (performance log, round four). Soft triangle meshes
+        // are the exception: there the directional terms (`primitives::directional`)
+        // bring the bound steps 10-30 epsilons nearer the surface, where a full value
+        // at the hit beta costs hundreds of leaves (doc/performance-log.md, round
+        // thirty).
+        p.moments &= !bound || self.soft_triangles();
         p.far_share = far_share;
         eval::evaluate_along(sets, x, along, &p, grad)
     }

@@ -37,11 +37,14 @@
 //!    decides the hit. The bound value that falls through is still a safe step
 //!    when it is above epsilon (no full value there could hit), and it is taken: on
 //!    edges and triangles the coarse sum is nearly exact, and a full evaluation at the
-//!    same point would only repeat it. On edges and triangles the full value that
-//!    follows a bound that fell through is taken at the hit beta, with the gradient
-//!    (item 9): at the scene's beta it is several epsilons low near their surfaces and
-//!    only takes a step the next, finer evaluation repeats (doc/performance-log.md,
-//!    round twenty-six). The gap between that bound value and the full
+//!    same point would only repeat it. (Not near soft triangle meshes, where its
+//!    closest-box far terms put it 15-30 epsilons low: there its far terms take the
+//!    directional tables too, `TraceObject::evaluate`, and the bound steps end nearer
+//!    the surface; doc/performance-log.md, round thirty.) On edges and triangles the
+//!    full value that follows a bound that fell through is taken at the hit beta, with
+//!    the gradient (item 9): at the scene's beta it is several epsilons low near their
+//!    surfaces and only takes a step the next, finer evaluation repeats
+//!    (doc/performance-log.md, round twenty-six). The gap between that bound value and the full
 //!    value that follows is kept: a later bound step is taken only where the full value
 //!    minus the gap clears twice the threshold (near a soft point cloud the coarse sum
 //!    is several epsilons low, and a bound step there would only fall through again).
