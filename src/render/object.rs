@@ -184,9 +184,10 @@ impl TraceObject {
         // either keeps a bound step safe, and the tighter moment terms buy no longer steps
         // there for their extra cost (performance log, round four). Soft triangle meshes
         // are the exception: there the directional terms (`primitives::directional`)
-        // bring the bound steps 10-30 epsilons nearer the surface, where a full value
-        // at the hit beta costs hundreds of leaves (doc/performance-log.md, round
-        // thirty).
+        // bring the bound steps nearer the surface, and fewer full values follow, each
+        // of hundreds of leaves (the published full bunny's far view: the first full
+        // value 12-24 epsilons out on 76% of the hit rays, 12-48 on 72% before;
+        // doc/performance-log.md, round thirty).
         p.moments &= !bound || self.soft_triangles();
         p.far_share = far_share;
         eval::evaluate_along(sets, x, along, &p, grad)

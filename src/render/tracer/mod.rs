@@ -44,10 +44,11 @@
 //!    full value that follows a bound that fell through is taken at the hit beta, with
 //!    the gradient (item 9): at the scene's beta it is several epsilons low near their
 //!    surfaces and only takes a step the next, finer evaluation repeats
-//!    (doc/performance-log.md, round twenty-six). The gap between that bound value and the full
-//!    value that follows is kept: a later bound step is taken only where the full value
-//!    minus the gap clears twice the threshold (near a soft point cloud the coarse sum
-//!    is several epsilons low, and a bound step there would only fall through again).
+//!    (doc/performance-log.md, round twenty-six). The gap between that bound value and
+//!    the full value that follows is kept: a later bound step is taken only where the
+//!    full value minus the gap clears twice the threshold (near a soft point cloud the
+//!    coarse sum is several epsilons low, and a bound step there would only fall
+//!    through again).
 //!    Primary rays reach this loop after their tile's cone march (`render::cone`), which
 //!    takes the far steps once for a whole tile, and start past the stretch that the
 //!    empty balls of the tile's last rays already certify (`render::neighbours`); a step
