@@ -31,6 +31,23 @@
 //!   of its centroid (`exp(alpha rho_max)` more), the largest weight (the bound of
 //!   point clouds, `eval::smooth`, carried over to primitives with extent).
 //!
+//! On edges, four more (doc/performance-log.md, round thirty-one): an edge's weight split
+//! into its ends' weight `w_E` (the larger of the two, everywhere along the edge) and the
+//! bump above it inside the edge (at most `b`, both from `primitives::support`'s
+//! pieces, certain). The bump counts only where the closest point is inside the edge,
+//! which needs the query to see the edge at nearly a right angle: `|e . u| <= h / l` for
+//! the box's half diagonal `h` at distance `l` from its centre.
+//! - `split, exact bump`: `w_E` with the directional distance, plus each edge's actual
+//!   rise above `w_E` where its closest point is inside it (an oracle);
+//! - `split, right-angle bumps`: the same with `b` for every edge that passes the test
+//!   (certain, with the exact direction);
+//! - `grid, ends' weight alone`: `w_E`'s weighted support on the 25-direction grid, no
+//!   bump (not a bound: the floor of what the grid can reach);
+//! - `grid, ends' weight + axis-bin bumps`: that plus, per bin of edge directions (one
+//!   per pair of opposite points of a 9 x 9 grid, 33 axes), the bumps' weighted support
+//!   on the grid where the bin's axis passes the test widened by its edges' largest
+//!   angle to it (certain; the tables a walk could read).
+//!
 //! The weights' maxima over an edge or a face are sampled (17 points per edge, 66 per
 //! face, 91 per primitive for the weighted support), not bounded: these are
 //! measurements of what a bound could reach, not bounds. Except in the grid's tables
@@ -54,7 +71,7 @@ use smoothtrace::reports::quantile;
 use smoothtrace::scene::Scene;
 use std::path::Path;
 
-const NAMES: [&str; 9] = [
+const NAMES: [&str; 13] = [
     "box, max weight",
     "box, actual weights",
     "box, cone weights",
@@ -64,7 +81,17 @@ const NAMES: [&str; 9] = [
     "directional, weighted support",
     "centroid moments",
     "weighted support, 25-direction grid",
+    "split, exact bump (edges)",
+    "split, right-angle bumps (edges)",
+    "grid, ends' weight alone (edges)",
+    "grid, ends' weight + axis-bin bumps (edges)",
 ];
+
+/// The side of the grid whose points give the bump bins' axes (33 axes).
+const BUMP_AXES: usize = 9;
+
+/// A node's bins of edge directions that hold a bump: axis, largest chord, grid table.
+type BumpBins = Vec<(DVec3, f64, Vec<f64>)>;
 
 /// What a far term needs to know of one primitive: its vertices (an edge's second
 /// repeated), the largest weight at a vertex, along each edge and over the face, the
@@ -89,6 +116,12 @@ trait Vertices: Primitive {
         _alpha: f64,
         _scale: &WeightScale,
     ) -> Option<Vec<f64>> {
+        None
+    }
+
+    /// Edges: `(w_E, b)`, the ends' weight and the bound of the bump above it (module
+    /// docs), certain.
+    fn bump_split(&self, _scale: &WeightScale) -> Option<(f64, f64)> {
         None
     }
 }
@@ -117,6 +150,13 @@ impl Vertices for Edge {
                 .map(|&g| edge_weighted_support(self, g, alpha, &lw))
                 .collect(),
         )
+    }
+
+    fn bump_split(&self, scale: &WeightScale) -> Option<(f64, f64)> {
+        let lw = edge_piece_log_weights(self, scale);
+        let end = lw[0].max(lw[lw.len() - 1]);
+        let peak = lw.iter().fold(end, |m, &v| m.max(v));
+        Some((end.exp(), (peak.exp() - end.exp()).max(0.0)))
     }
 }
 
@@ -176,6 +216,11 @@ impl Shape {
     }
 }
 
+/// An edge's two ends (the shape repeats the second).
+fn edge_ends(s: &Shape) -> [DVec3; 2] {
+    [s.v[0], s.v[1]]
+}
+
 /// The grid's size: 5 x 5 directions (round twenty-one's).
 const G: usize = 5;
 
@@ -211,17 +256,41 @@ struct Oracle<'s, P> {
     /// about the origin, summed over its primitives in the log domain, and (last) at
     /// the zero direction (`ln sum w_max`).
     tables: Vec<Vec<f64>>,
+    /// Edges: per primitive `(w_E, b)` (module docs); empty for triangles.
+    split: Vec<(f64, f64)>,
+    /// Edges: per node, the ends' weight's grid table (as `tables`), and per bin of
+    /// edge directions that holds a bump its axis, largest chord and grid table.
+    end_tables: Vec<Vec<f64>>,
+    bump_bins: Vec<BumpBins>,
     /// Far terms whose grid bound fell below their exact sum, and the worst ratio.
     violations: std::cell::Cell<usize>,
     worst: std::cell::Cell<f64>,
 }
 
 impl<P: Vertices> Oracle<'_, P> {
-    /// Each bound's sum at `x` for `beta`, the exact sum, and the leaves.
-    fn sums(&self, x: DVec3, beta: f64) -> ([f64; 9], f64, usize) {
+    /// A node's grid table `t` (about the origin) at the unit `u` from its centre `c`.
+    fn on_grid(&self, t: &[f64], u: DVec3, c: DVec3) -> f64 {
+        let (idx, mu) = self.grid.cone(u);
+        let m: f64 = mu.iter().sum();
+        let sc = self.grid.scale();
+        let mut d = (1.0 - m / sc) * t[self.grid.len()];
+        for k in 0..3 {
+            // About the centre c: the support shifts by -g . c.
+            let g = sc * self.grid.direction(idx[k]);
+            d += mu[k] / sc * (t[idx[k]] - self.alpha * g.dot(c));
+        }
+        d
+    }
+
+    /// Each bound's sum at `x` for `beta` (NaN for rows that do not apply), the exact
+    /// sum, and the leaves.
+    fn sums(&self, x: DVec3, beta: f64) -> ([f64; 13], f64, usize) {
         let (nodes, prims, alpha) = (&self.set.bvh.nodes, &self.set.prims, self.alpha);
         let w_max = self.scale.max_weight();
-        let mut sums = [0.0; 9];
+        let mut sums = [0.0; 13];
+        if self.split.is_empty() {
+            sums[9..].fill(f64::NAN);
+        }
         let (mut exact, mut leaves) = (0.0, 0);
         let mut stack = vec![0usize];
         while let Some(i) = stack.pop() {
@@ -249,16 +318,7 @@ impl<P: Vertices> Oracle<'_, P> {
                 // Round twenty-eight's proposal: the weighted support tabulated at the
                 // grid and bounded between them by convexity.
                 {
-                    let t = &self.tables[i];
-                    let (idx, mu) = self.grid.cone(u);
-                    let m: f64 = mu.iter().sum();
-                    let sc = self.grid.scale();
-                    let mut d = (1.0 - m / sc) * t[self.grid.len()];
-                    for k in 0..3 {
-                        // About the centre c: the support shifts by -g . c.
-                        let g = sc * self.grid.direction(idx[k]);
-                        d += mu[k] / sc * (t[idx[k]] - alpha * g.dot(c));
-                    }
+                    let d = self.on_grid(&self.tables[i], u, c);
                     let bound = (-alpha * u.dot(x - c) + d).exp();
                     if bound < node_exact * (1.0 - 1e-9) {
                         self.violations.set(self.violations.get() + 1);
@@ -268,6 +328,43 @@ impl<P: Vertices> Oracle<'_, P> {
                         }
                     }
                     sums[8] += bound.min(count * w_max * boxed);
+                }
+                if !self.split.is_empty() {
+                    // The bump counts where the edge is seen at nearly a right angle.
+                    let right = 0.5 * n.diam as f64 / l;
+                    let (mut oracle, mut certain) = (0.0, 0.0);
+                    for k in range.clone() {
+                        let (w_e, b) = self.split[k];
+                        let v = edge_ends(&self.shapes[k]);
+                        let dir = (-alpha
+                            * (l - v
+                                .iter()
+                                .map(|&p| u.dot(p - c))
+                                .fold(f64::NEG_INFINITY, f64::max)))
+                        .exp();
+                        oracle += w_e * dir;
+                        certain += w_e * dir;
+                        let (a, e) = (v[0], v[1] - v[0]);
+                        let t = (x - a).dot(e) / e.length_squared();
+                        if t > 0.0 && t < 1.0 {
+                            let (d, w) = prims[k].value(x, &self.scale);
+                            oracle += (w - w_e).max(0.0) * (-alpha * d).exp();
+                        }
+                        if u.dot(e.normalize_or_zero()).abs() <= right {
+                            certain += b * dir;
+                        }
+                    }
+                    let box_term = count * w_max * boxed;
+                    sums[9] += oracle.min(box_term);
+                    sums[10] += certain.min(box_term);
+                    let ends = (-alpha * l + self.on_grid(&self.end_tables[i], u, c)).exp();
+                    sums[11] += ends.min(box_term);
+                    let bumps: f64 = self.bump_bins[i]
+                        .iter()
+                        .filter(|(axis, chord, _)| axis.dot(u).abs() <= right + chord)
+                        .map(|(_, _, t)| (-alpha * l + self.on_grid(t, u, c)).exp())
+                        .sum();
+                    sums[12] += (ends + bumps).min(box_term);
                 }
                 let (mut moment_var, mut moment_z, mut rho_max) = (0.0, 0.0f64, 0.0f64);
                 let mean: DVec3 = range
@@ -344,6 +441,82 @@ impl<P: Vertices> Oracle<'_, P> {
     }
 }
 
+/// Per node of an edge set: the ends' weight's grid table and the bins' bump tables
+/// (module docs), about the origin.
+fn split_tables<P: Vertices>(
+    set: &PrimitiveSet<P>,
+    split: &[(f64, f64)],
+    start: &[usize],
+    grid: &DirectionGrid,
+    alpha: f64,
+) -> (Vec<Vec<f64>>, Vec<BumpBins>) {
+    let dirs: Vec<DVec3> = (0..grid.len())
+        .map(|k| grid.scale() * grid.direction(k))
+        .chain([DVec3::ZERO])
+        .collect();
+    let axis_grid = DirectionGrid::new(BUMP_AXES);
+    let axes: Vec<DVec3> = (0..axis_grid.len())
+        .map(|k| axis_grid.direction(k))
+        .filter(|a| {
+            let first = if a.z != 0.0 {
+                a.z
+            } else if a.y != 0.0 {
+                a.y
+            } else {
+                a.x
+            };
+            first > 0.0
+        })
+        .collect();
+    let supports = |p: &P, w: f64| -> Vec<f64> {
+        let v = p.vertices();
+        dirs.iter()
+            .map(|g| alpha * g.dot(v[0]).max(g.dot(v[1])) + w.ln())
+            .collect()
+    };
+    // Per edge: its bin's index and chord (the nearer of the axis' two directions).
+    let bins: Vec<(usize, f64)> = set
+        .prims
+        .iter()
+        .map(|p| {
+            let v = p.vertices();
+            let e = (v[1] - v[0]).normalize_or_zero();
+            axes.iter()
+                .map(|a| (e - *a).length().min((e + *a).length()))
+                .enumerate()
+                .fold((0, f64::INFINITY), |b, c| if c.1 < b.1 { c } else { b })
+        })
+        .collect();
+    let mut end_tables = Vec::new();
+    let mut bump_bins = Vec::new();
+    for (i, n) in set.bvh.nodes.iter().enumerate() {
+        let mut ends = vec![f64::NEG_INFINITY; dirs.len()];
+        let mut node_bins: BumpBins = Vec::new();
+        let mut bin_of: std::collections::HashMap<usize, usize> = Default::default();
+        for k in start[i]..start[i] + n.size as usize {
+            let (w_e, b) = split[k];
+            for (t, v) in ends.iter_mut().zip(supports(&set.prims[k], w_e)) {
+                *t = lse(*t, v);
+            }
+            if b > 0.0 {
+                let (axis, chord) = bins[k];
+                let j = *bin_of.entry(axis).or_insert_with(|| {
+                    node_bins.push((axes[axis], 0.0, vec![f64::NEG_INFINITY; dirs.len()]));
+                    node_bins.len() - 1
+                });
+                let bin = &mut node_bins[j];
+                bin.1 = bin.1.max(chord);
+                for (t, v) in bin.2.iter_mut().zip(supports(&set.prims[k], b)) {
+                    *t = lse(*t, v);
+                }
+            }
+        }
+        end_tables.push(ends);
+        bump_bins.push(node_bins);
+    }
+    (end_tables, bump_bins)
+}
+
 fn run<P: Vertices>(
     set: &PrimitiveSet<P>,
     points: &[DVec3],
@@ -408,7 +581,20 @@ fn run<P: Vertices>(
             t
         })
         .collect();
+    let split: Vec<(f64, f64)> = set
+        .prims
+        .iter()
+        .map_while(|p| p.bump_split(&scale))
+        .collect();
+    let (end_tables, bump_bins) = if split.is_empty() {
+        (Vec::new(), Vec::new())
+    } else {
+        split_tables(set, &split, &start, &grid, alpha)
+    };
     let oracle = Oracle {
+        split,
+        end_tables,
+        bump_bins,
         violations: Default::default(),
         worst: std::cell::Cell::new(1.0),
         grid,
@@ -438,6 +624,9 @@ fn run<P: Vertices>(
             oracle.worst.get() - 1.0
         );
         for (name, d) in NAMES.iter().zip(&mut deficits) {
+            if d.iter().all(|v| v.is_nan()) {
+                continue;
+            }
             println!(
                 "  {name:30} deficit p50 {:.3}, p90 {:.3} epsilons",
                 quantile(d, 0.5).unwrap_or(f64::NAN),
