@@ -262,6 +262,9 @@ struct Oracle<'s, P> {
     /// edge directions that holds a bump its axis, largest chord and grid table.
     end_tables: Vec<Vec<f64>>,
     bump_bins: Vec<BumpBins>,
+    /// Edges of far terms, and those whose closest point lies inside them.
+    far_edges: std::cell::Cell<usize>,
+    inside: std::cell::Cell<usize>,
     /// Far terms whose grid bound fell below their exact sum, and the worst ratio.
     violations: std::cell::Cell<usize>,
     worst: std::cell::Cell<f64>,
@@ -346,7 +349,9 @@ impl<P: Vertices> Oracle<'_, P> {
                         certain += w_e * dir;
                         let (a, e) = (v[0], v[1] - v[0]);
                         let t = (x - a).dot(e) / e.length_squared();
+                        self.far_edges.set(self.far_edges.get() + 1);
                         if t > 0.0 && t < 1.0 {
+                            self.inside.set(self.inside.get() + 1);
                             let (d, w) = prims[k].value(x, &self.scale);
                             oracle += (w - w_e).max(0.0) * (-alpha * d).exp();
                         }
@@ -595,6 +600,8 @@ fn run<P: Vertices>(
         split,
         end_tables,
         bump_bins,
+        far_edges: Default::default(),
+        inside: Default::default(),
         violations: Default::default(),
         worst: std::cell::Cell::new(1.0),
         grid,
@@ -607,6 +614,8 @@ fn run<P: Vertices>(
         widen,
     };
     for &beta in betas {
+        oracle.far_edges.set(0);
+        oracle.inside.set(0);
         let mut deficits: Vec<Vec<f64>> = vec![Vec::new(); NAMES.len()];
         let mut leaves = 0;
         for &x in points {
@@ -623,6 +632,12 @@ fn run<P: Vertices>(
             oracle.violations.get(),
             oracle.worst.get() - 1.0
         );
+        if oracle.far_edges.get() > 0 {
+            println!(
+                "  far terms' edges whose closest point lies inside them: {:.1}%",
+                100.0 * oracle.inside.get() as f64 / oracle.far_edges.get() as f64
+            );
+        }
         for (name, d) in NAMES.iter().zip(&mut deficits) {
             if d.iter().all(|v| v.is_nan()) {
                 continue;
