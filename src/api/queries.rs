@@ -297,9 +297,15 @@ mod tests {
                     }
                     widths.push(width * obj.params.alpha);
                 }
-                // Exact at beta 0 up to the pruning (a share 1e-10 of the sum).
+                // Exact at beta 0 up to the pruning (a share 1e-10 of the sum), and
+                // wider at a coarser beta, beyond what pruning alone moves (where no
+                // far term is taken, as on stiff edges, whose leaves hold eight, the
+                // widths are pruning's at every beta).
                 assert!(widths[0] < 1e-8, "{kind:?} {alpha_rel}: {widths:?}");
-                assert!(widths[2] >= widths[1], "{kind:?} {alpha_rel}: {widths:?}");
+                assert!(
+                    widths[2] + 1e-8 >= widths[1],
+                    "{kind:?} {alpha_rel}: {widths:?}"
+                );
             }
         }
     }

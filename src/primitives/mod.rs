@@ -13,7 +13,7 @@ pub mod triangle_support;
 pub mod weights;
 
 pub use kinds::{Edge, Point, Primitive, Slope, Term, Triangle};
-pub use sets::{AnySet, BuildTimes, PrimitiveError, PrimitiveSet};
+pub use sets::{AnySet, BuildTimes, EDGE_LEAF_SIZE, PrimitiveError, PrimitiveSet};
 pub use weights::WeightScale;
 
 /// Which kind of primitive a set holds. Scene files and the command line name them

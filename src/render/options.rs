@@ -41,6 +41,12 @@ pub struct TracerOptions {
     /// round twenty-nine gave triangles the directional far field). Not with certified
     /// hits, which start from `hit_beta_scale`.
     pub hit_beta_scale_soft_triangles: f64,
+    /// The same for objects made of edges alone, at any `alpha`: their leaves hold
+    /// eight edges (`primitives::EDGE_LEAF_SIZE`), summed exactly near a query, and at
+    /// 0.8 their hits stay closer to the exact surface than at 0.6 with leaves of four
+    /// (doc/performance-log.md, round thirty-two). Not with certified hits, which start
+    /// from `hit_beta_scale`.
+    pub hit_beta_scale_edges: f64,
     /// Evaluations at the hit beta on edges and triangles also take a subtree as one
     /// far-field term when its bound is at most this share of the sum
     /// (`eval::FarShare`, tracer module docs item 9; 0 = off, the paper's).
@@ -109,6 +115,7 @@ impl TracerOptions {
             relax: true,
             hit_beta_scale: 0.6,
             hit_beta_scale_soft_triangles: 0.8,
+            hit_beta_scale_edges: 0.8,
             far_share: FAR_SHARE,
             step_beta: 1.0,
             learn_step_beta: true,
@@ -134,6 +141,7 @@ impl TracerOptions {
             relax: false,
             hit_beta_scale: 1.0,
             hit_beta_scale_soft_triangles: 1.0,
+            hit_beta_scale_edges: 1.0,
             far_share: 0.0,
             step_beta: 0.0,
             learn_step_beta: false,

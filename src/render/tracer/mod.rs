@@ -78,7 +78,10 @@
 //!    scene's, 0.6 by default; 0.8, `hit_beta_scale_soft_triangles`, for soft fields
 //!    over triangle meshes, `TraceObject::soft_triangles`, where with the directional
 //!    far field it keeps the hits within the accuracy goals with a quarter fewer leaves:
-//!    doc/performance-log.md, rounds twenty-one and twenty-nine): the Barnes-Hut sum is a lower bound of the exact one,
+//!    doc/performance-log.md, rounds twenty-one and twenty-nine; 0.8 too,
+//!    `hit_beta_scale_edges`, for objects made of edges alone, whose leaves of eight
+//!    edges, summed exactly, keep the hits closer to the exact surface than leaves of
+//!    four at 0.6: round thirty-two): the Barnes-Hut sum is a lower bound of the exact one,
 //!    but where `alpha` times the size of far-field nodes is large (soft point clouds,
 //!    dense edge meshes at small `alpha`) it can be many epsilons low, and a ray that
 //!    stops where it drops below epsilon stops short of the exact surface. Evaluations
@@ -290,10 +293,15 @@ impl<'a> Tracer<'a> {
             .map(|(o, &points)| {
                 // Certified hits start from the meshes' hit beta on soft triangles too:
                 // their halvings reach the exact sum from there (item 11).
+                let edges = o.sets.iter().all(|s| matches!(s, AnySet::Edges(_)));
                 let scale = if points {
                     1.0
-                } else if o.soft_triangles() && !options.certified_hits {
+                } else if options.certified_hits {
+                    options.hit_beta_scale
+                } else if o.soft_triangles() {
                     options.hit_beta_scale_soft_triangles
+                } else if edges {
+                    options.hit_beta_scale_edges
                 } else {
                     options.hit_beta_scale
                 };
