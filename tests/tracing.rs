@@ -660,8 +660,9 @@ fn the_certified_upper_bound_lies_above_the_exact_value() {
 /// Soft fields over triangle meshes (`TraceObject::soft_triangles`: triangles alone,
 /// `alpha` times the median edge at most `SOFT_MAX_ALPHA_EDGE`) decide hits at
 /// `hit_beta_scale_soft_triangles` of the scene's beta; stiffer fields keep
-/// `hit_beta_scale` (edges alone: `hit_beta_scale_edges`; points: the scene's beta). The median edge of a grid of unit squares cut into triangles
-/// (legs 1, diagonals sqrt 2) is 1.
+/// `hit_beta_scale` (edges alone: `hit_beta_scale_edges`; points: the scene's beta).
+/// The median edge of a grid of unit squares cut into triangles (legs 1, diagonals sqrt
+/// 2) is 1.
 #[test]
 fn soft_triangle_meshes_are_told_apart_by_alpha_times_the_median_edge() {
     use smoothtrace::mesh::Mesh;

@@ -34,6 +34,8 @@ pub struct TracerOptions {
     pub relax: bool,
     /// Hits on objects with edges or triangles are decided at this share of the scene's
     /// beta (tracer module docs, item 9); 1 decides them at the scene's beta (the paper's).
+    /// Soft triangle meshes and edges alone take their own shares (below), except with
+    /// certified hits.
     pub hit_beta_scale: f64,
     /// The same for soft fields over triangle meshes (`TraceObject::soft_triangles`):
     /// many triangles within the kernel's width, where a coarser beta keeps the hits as

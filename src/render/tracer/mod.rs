@@ -291,8 +291,8 @@ impl<'a> Tracer<'a> {
             .iter()
             .zip(&points_only)
             .map(|(o, &points)| {
-                // Certified hits start from the meshes' hit beta on soft triangles too:
-                // their halvings reach the exact sum from there (item 11).
+                // Certified hits start from the meshes' hit beta on soft triangles and
+                // edges too: their halvings reach the exact sum from there (item 11).
                 let edges = o.sets.iter().all(|s| matches!(s, AnySet::Edges(_)));
                 let scale = if points {
                     1.0
