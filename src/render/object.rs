@@ -7,7 +7,7 @@ use crate::colour::ObjectColours;
 use crate::eval::{self, Along, EvalParams, FarShare, Sample};
 use crate::mesh::Aabb;
 use crate::primitives::directional::DirectionalTables;
-use crate::primitives::{AnySet, Primitive, PrimitiveSet, WeightScale};
+use crate::primitives::{AnySet, Primitive, PrimitiveKind, PrimitiveSet, WeightScale};
 use glam::DVec3;
 use std::sync::Arc;
 
@@ -101,6 +101,11 @@ impl TraceObject {
 
     pub fn set_refs(&self) -> Vec<&AnySet> {
         self.sets.iter().collect()
+    }
+
+    /// Every set of the object holds primitives of `kind`.
+    pub fn only(&self, kind: PrimitiveKind) -> bool {
+        self.sets.iter().all(|s| s.kind() == kind)
     }
 
     /// Whether the object is made of triangles alone and its `alpha` times their median

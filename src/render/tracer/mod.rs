@@ -184,7 +184,7 @@ use super::step_beta::StepBeta;
 use super::stepper::{Kind, Stepper};
 use crate::eval::Along;
 use crate::eval::params::MAX_PRUNE_TOLERANCE;
-use crate::primitives::AnySet;
+use crate::primitives::{AnySet, PrimitiveKind};
 use glam::DVec3;
 
 /// An evaluation is predicted to hit (and carries the gradient) when its predecessor's
@@ -285,7 +285,7 @@ impl<'a> Tracer<'a> {
         // (item 10) and an earlier end of the bound steps (item 5).
         let points_only: Vec<bool> = objects
             .iter()
-            .map(|o| o.sets.iter().all(|s| matches!(s, AnySet::Points(_))))
+            .map(|o| o.only(PrimitiveKind::Points))
             .collect();
         let hit_beta: Vec<f64> = objects
             .iter()
@@ -293,14 +293,13 @@ impl<'a> Tracer<'a> {
             .map(|(o, &points)| {
                 // Certified hits start from the meshes' hit beta on soft triangles and
                 // edges too: their halvings reach the exact sum from there (item 11).
-                let edges = o.sets.iter().all(|s| matches!(s, AnySet::Edges(_)));
                 let scale = if points {
                     1.0
                 } else if options.certified_hits {
                     options.hit_beta_scale
                 } else if o.soft_triangles() {
                     options.hit_beta_scale_soft_triangles
-                } else if edges {
+                } else if o.only(PrimitiveKind::Edges) {
                     options.hit_beta_scale_edges
                 } else {
                     options.hit_beta_scale
