@@ -2,11 +2,13 @@
 //! parameters. Each field's meaning is stated where it is declared; the items cited are
 //! those of the `render::tracer` module docs.
 
-/// The default [`TracerOptions::far_share`]: a far term by share lowers `s` by at most
-/// `share / alpha`; at 4e-4 the hits on the soft full bunny sit 0.07 epsilons farther
-/// from the exact surface at the median, for a fifth fewer leaves per hit ray
-/// (doc/performance-log.md, round twenty-two).
-pub const FAR_SHARE: f64 = 4e-4;
+/// The default [`TracerOptions::far_share`], in epsilons: a far term by share holds at
+/// most `far_share alpha epsilon` of the sum, so it lowers `s` by at most `far_share
+/// epsilon`. At 0.075 the soft cells of the speed matrix (`alpha * diag` 100 and 250,
+/// edges and triangles, seven meshes) take 11-24% fewer leaves per ray than at the
+/// fixed share of 4e-4 before, and every cell keeps its place against the accuracy goals
+/// (doc/performance-log.md, rounds twenty-two and thirty-three).
+pub const FAR_SHARE: f64 = 0.075;
 
 /// Tracer settings.
 #[derive(Clone, Copy, Debug)]
@@ -50,8 +52,9 @@ pub struct TracerOptions {
     /// from `hit_beta_scale`.
     pub hit_beta_scale_edges: f64,
     /// Evaluations at the hit beta on edges and triangles also take a subtree as one
-    /// far-field term when its bound is at most this share of the sum
-    /// (`eval::FarShare`, tracer module docs item 9; 0 = off, the paper's).
+    /// far-field term when its bound is at most `far_share alpha epsilon` of the sum
+    /// (`eval::FarShare`, tracer module docs item 9): each such term lowers `s` by at
+    /// most `far_share` epsilons. 0 = off, the paper's.
     pub far_share: f64,
     /// Full evaluations that only take a step (not predicted to hit) are made at this
     /// opening parameter when it is coarser than the scene's (0 = the scene's beta):

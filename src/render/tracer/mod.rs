@@ -95,15 +95,18 @@
 //!    On edges and triangles whose hit band is narrow against the kernel (`alpha
 //!    epsilon < 0.4`, where the pruning tolerance of item 6 is below its cap and a sum
 //!    holds many terms), evaluations at the hit beta also take a subtree as one
-//!    far-field term when its closest-box bound is at most `TracerOptions::far_share`
-//!    (4e-4) of the sum (`eval::FarShare`): of the sum so far, or of the sum at the
-//!    ray's last full value, which the new one is expected not to exceed (early in a
-//!    walk the sum so far is small). Beta opens a subtree by its size against its
-//!    distance; the share leaves it closed when its terms cannot weigh much. Still a
-//!    lower bound: on the softest cells of the speed matrix a quarter fewer leaves per
-//!    ray, the hits 0.07 epsilons farther from the exact surface at the median on the
-//!    soft full bunny (doc/performance-log.md, round twenty-two). Off with certified
-//!    hits (item 11), whose halvings must reach the exact sum.
+//!    far-field term when its closest-box bound is at most `far_share alpha epsilon` of
+//!    the sum (`TracerOptions::far_share`, 0.075; `eval::FarShare`): of the sum so far,
+//!    or of the sum at the ray's last full value, which the new one is expected not to
+//!    exceed (early in a walk the sum so far is small). Beta opens a subtree by its size
+//!    against its distance; the share leaves it closed when its terms cannot weigh
+//!    much: each such term lowers the value by at most `far_share` epsilons, as the
+//!    pruning tolerance (item 6) is tied to epsilon. Still a lower bound. A fixed share
+//!    of 4e-4 took a quarter off the leaves per ray of the softest cells of the speed
+//!    matrix (doc/performance-log.md, round twenty-two); the share tied to epsilon takes
+//!    11-24% more off the soft cells (`alpha * diag` 100-250), each cell as near the
+//!    accuracy goals as before (round thirty-three). Off with certified hits (item 11),
+//!    whose halvings must reach the exact sum.
 //! 10. On point clouds, full evaluations that only take a step (not predicted to hit)
 //!     are made at the coarser `TracerOptions::step_beta` (1 by default): a lower bound
 //!     too, so the step is safe, at 60-75% of the terms near the surface; a value in
@@ -335,11 +338,12 @@ impl<'a> Tracer<'a> {
         let far_share = points_only
             .iter()
             .zip(&narrow)
-            .map(|(&points, &narrow)| {
+            .zip(objects)
+            .map(|((&points, &narrow), o)| {
                 if points || !narrow || options.certified_hits {
                     0.0
                 } else {
-                    options.far_share
+                    options.far_share * o.params.alpha * options.epsilon
                 }
             })
             .collect();
