@@ -5,7 +5,7 @@
 /// The default [`TracerOptions::far_share`], in epsilons: a far term by share holds at
 /// most `far_share alpha epsilon` of the sum, so it lowers `s` by at most `far_share
 /// epsilon`. At 0.075 the soft cells of the speed matrix (`alpha * diag` 100 and 250,
-/// edges and triangles, seven meshes) take 11-24% fewer leaves per ray than at the
+/// edges and triangles, seven meshes) take 11-30% fewer leaves per ray than at the
 /// fixed share of 4e-4 before, and every cell keeps its place against the accuracy goals
 /// (doc/performance-log.md, rounds twenty-two and thirty-three).
 pub const FAR_SHARE: f64 = 0.075;

@@ -104,8 +104,8 @@
 //!    pruning tolerance (item 6) is tied to epsilon. Still a lower bound. A fixed share
 //!    of 4e-4 took a quarter off the leaves per ray of the softest cells of the speed
 //!    matrix (doc/performance-log.md, round twenty-two); the share tied to epsilon takes
-//!    11-24% more off the soft cells (`alpha * diag` 100-250), each cell as near the
-//!    accuracy goals as before (round thirty-three). Off with certified hits (item 11),
+//!    11-30% more off the soft cells (`alpha * diag` 100-250), and no cell crosses an
+//!    accuracy goal it met (round thirty-three). Off with certified hits (item 11),
 //!    whose halvings must reach the exact sum.
 //! 10. On point clouds, full evaluations that only take a step (not predicted to hit)
 //!     are made at the coarser `TracerOptions::step_beta` (1 by default): a lower bound
