@@ -33,6 +33,11 @@ pub struct DirectionGrid {
     unit: Vec<DVec3>,
     /// The lengths of their octahedron points.
     oct_len: Vec<f64>,
+    /// Per square `(i, j)` (`j (n - 1) + i`): its two triangles' grid points, lower then
+    /// upper (`triangle`).
+    triangles: Vec<[usize; 3]>,
+    /// Per square: px and py have one sign there (the fold runs along its anti-diagonal).
+    anti: Vec<bool>,
     scale: f64,
 }
 
@@ -64,8 +69,17 @@ impl DirectionGrid {
             n,
             unit,
             oct_len,
+            triangles: Vec::new(),
+            anti: Vec::new(),
             scale: 1.0,
         };
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                grid.triangles.push(grid.triangle(i, j, false));
+                grid.triangles.push(grid.triangle(i, j, true));
+                grid.anti.push(grid.anti_square(i, j));
+            }
+        }
         let mut nearest = f64::INFINITY;
         for j in 0..n - 1 {
             for i in 0..n - 1 {
@@ -102,15 +116,19 @@ impl DirectionGrid {
         self.unit[k]
     }
 
-    /// The grid points of triangle `upper` (0 or 1) of square `(i, j)`.
-    fn triangle(&self, i: usize, j: usize, upper: bool) -> [usize; 3] {
-        let v = |a: usize, b: usize| (j + b) * self.n + i + a;
+    /// Where px and py have one sign the fold line runs along the squares'
+    /// anti-diagonals, elsewhere along their diagonals.
+    fn anti_square(&self, i: usize, j: usize) -> bool {
         let h = 2.0 / (self.n - 1) as f64;
         let cx = -1.0 + (i as f64 + 0.5) * h;
         let cy = -1.0 + (j as f64 + 0.5) * h;
-        // Where px and py have one sign the fold line runs along the squares'
-        // anti-diagonals, elsewhere along their diagonals.
-        match (cx * cy > 0.0, upper) {
+        cx * cy > 0.0
+    }
+
+    /// The grid points of triangle `upper` (0 or 1) of square `(i, j)`.
+    fn triangle(&self, i: usize, j: usize, upper: bool) -> [usize; 3] {
+        let v = |a: usize, b: usize| (j + b) * self.n + i + a;
+        match (self.anti_square(i, j), upper) {
             (true, false) => [v(0, 0), v(1, 0), v(0, 1)],
             (true, true) => [v(1, 1), v(1, 0), v(0, 1)],
             (false, false) => [v(0, 0), v(1, 0), v(1, 1)],
@@ -121,39 +139,59 @@ impl DirectionGrid {
     /// The grid directions `k` whose cone holds the unit direction `u` and `mu` (module
     /// docs: `u = sum mu_k g_k`, `mu_k >= 0`, `sum mu_k <= scale`).
     pub fn cone(&self, u: DVec3) -> ([usize; 3], [f64; 3]) {
-        let norm1 = u.x.abs() + u.y.abs() + u.z.abs();
-        let o = u / norm1;
-        let (px, py) = if o.z >= 0.0 {
-            (o.x, o.y)
-        } else {
-            (
-                (1.0 - o.y.abs()) * o.x.signum(),
-                (1.0 - o.x.abs()) * o.y.signum(),
-            )
-        };
+        self.cone_of(u, 1.0)
+    }
+
+    /// [`DirectionGrid::cone`] of the unit direction `v / l`, for `v` nonzero and `l` its
+    /// length. Without branches on the direction (far terms look in every direction, and
+    /// a branch on it is a coin toss): both sides of every choice are computed and one is
+    /// kept.
+    #[inline]
+    pub fn cone_of(&self, v: DVec3, l: f64) -> ([usize; 3], [f64; 3]) {
+        let a = v.abs();
+        let norm1 = a.x + a.y + a.z;
+        let o = v * (1.0 / norm1);
+        // Below the fold: `((1 - |o_y|) sgn o_x, (1 - |o_x|) sgn o_y)` (`decode`'s inverse).
+        let below = o.z < 0.0;
+        let px = pick(below, (1.0 - o.y.abs()).copysign(o.x), o.x);
+        let py = pick(below, (1.0 - o.x.abs()).copysign(o.y), o.y);
         let cells = (self.n - 1) as f64;
         let fi = ((px + 1.0) * 0.5 * cells).clamp(0.0, cells);
         let fj = ((py + 1.0) * 0.5 * cells).clamp(0.0, cells);
         let (i, j) = ((fi as usize).min(self.n - 2), (fj as usize).min(self.n - 2));
         let (fx, fy) = (fi - i as f64, fj - j as f64);
-        let h = 2.0 / cells;
-        let anti = (-1.0 + (i as f64 + 0.5) * h) * (-1.0 + (j as f64 + 0.5) * h) > 0.0;
-        let (upper, lambda) = if anti {
-            if fx + fy <= 1.0 {
-                (false, [1.0 - fx - fy, fx, fy])
-            } else {
-                (true, [fx + fy - 1.0, 1.0 - fy, 1.0 - fx])
-            }
-        } else if fx >= fy {
-            (false, [1.0 - fx, fx - fy, fy])
-        } else {
-            (true, [1.0 - fy, fy - fx, fx])
-        };
-        let idx = self.triangle(i, j, upper);
-        // |o_u| = |u| / |u|_1 = 1 / |u|_1 for a unit u.
-        let mu = [0, 1, 2].map(|k| lambda[k].max(0.0) * self.oct_len[idx[k]] * norm1);
+        let square = j * (self.n - 1) + i;
+        // Along the anti-diagonal where px and py have one sign, else the diagonal.
+        let anti = self.anti[square];
+        let upper = (anti & (fx + fy > 1.0)) | (!anti & (fx < fy));
+        let lambda = pick3(
+            anti,
+            pick3(
+                upper,
+                [fx + fy - 1.0, 1.0 - fy, 1.0 - fx],
+                [1.0 - fx - fy, fx, fy],
+            ),
+            pick3(upper, [1.0 - fy, fy - fx, fx], [1.0 - fx, fx - fy, fy]),
+        );
+        let idx = self.triangles[2 * square + usize::from(upper)];
+        // |o_u| = |u| / |u|_1 = l / |v|_1.
+        let scale = norm1 / l;
+        let mu = [0, 1, 2].map(|k| lambda[k].max(0.0) * self.oct_len[idx[k]] * scale);
         (idx, mu)
     }
+}
+
+/// `if c { a } else { b }` for doubles, as a select.
+#[inline(always)]
+fn pick(c: bool, a: f64, b: f64) -> f64 {
+    let m = (c as u64).wrapping_neg();
+    f64::from_bits((a.to_bits() & m) | (b.to_bits() & !m))
+}
+
+/// [`pick`] of three.
+#[inline(always)]
+fn pick3(c: bool, a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|k| pick(c, a[k], b[k]))
 }
 
 #[cfg(test)]

@@ -264,7 +264,7 @@ impl DirectionalTables {
             return None;
         }
         let t = &self.values[(i * ENTRIES + e) * VALUES..(i * ENTRIES + e + 1) * VALUES];
-        let (idx, mu) = self.grid.cone(v / l);
+        let (idx, mu) = self.grid.cone_of(v, l);
         let s = self.grid.scale();
         let m: f64 = mu.iter().sum();
         let mut d = (1.0 - m / s).max(0.0) * t[VALUES - 1] as f64;
