@@ -156,6 +156,12 @@ impl Accumulator {
         self.alpha
     }
 
+    /// `1 / alpha`, kept: a product costs less than a division.
+    #[inline]
+    pub fn inv_alpha(&self) -> f64 {
+        self.inv_alpha
+    }
+
     /// The shifted sum `S` (before any [`Accumulator::inflate`] it is the sum of the
     /// added terms, relative to `exp(-alpha m)`).
     #[inline]

@@ -231,7 +231,7 @@ impl<const GRAD: bool, const SLOPE: bool> Sink<'_, GRAD, SLOPE> {
         if l == 0.0 {
             a
         } else {
-            (a - l / self.acc.alpha()).clamp(-1.0, 1.0)
+            (a - l * self.acc.inv_alpha()).clamp(-1.0, 1.0)
         }
     }
 
