@@ -219,6 +219,30 @@ fn render_writes_png_stats_and_depth() {
         steps > 0.0 && steps < evals,
         "{steps} step of {evals} evaluations"
     );
+    // The full evaluations by value account for every full evaluation and its leaves
+    // (with those that only took a hit's gradient), one bin more than the edges.
+    let image = &json["image"];
+    let by = &image["full_evaluations_by_value"];
+    let sum = |key: &str| -> u64 {
+        by[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_u64().unwrap())
+            .sum()
+    };
+    let bins = by["evaluations"].as_array().unwrap().len();
+    assert_eq!(bins, by["edges_epsilons"].as_array().unwrap().len() + 1);
+    assert_eq!(
+        sum("evaluations") + by["gradient_evaluations"].as_u64().unwrap(),
+        image["evals"].as_u64().unwrap()
+    );
+    assert_eq!(
+        sum("leaves") + by["gradient_leaves"].as_u64().unwrap(),
+        image["leaves"].as_u64().unwrap() - image["coarse_leaves"].as_u64().unwrap()
+    );
+    // Rays that hit end at a value within the band or just above it.
+    assert!(by["evaluations"][1].as_u64().unwrap() > 0, "{by}");
     let depth = image::open(d.path().join("depth.exr")).unwrap().to_rgb32f();
     let centre = depth.get_pixel(24, 16)[0];
     assert!(centre > 2.0 && centre < 4.0, "depth at the centre {centre}");

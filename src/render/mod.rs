@@ -18,4 +18,5 @@ pub use tracer::{Hit, RayResult, RayStats, Tracer};
 pub mod albedo;
 pub mod build;
 pub mod image;
+mod image_stats;
 pub mod pipeline;

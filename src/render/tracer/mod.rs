@@ -176,7 +176,7 @@ mod hit;
 mod ray;
 mod sample;
 
-pub use ray::{Hit, RayResult, RayStats};
+pub use ray::{ByValue, Hit, RayResult, RayStats, VALUE_BINS, VALUE_EDGES};
 use sample::MAX_HALVINGS;
 pub(super) use sample::{FieldSample, Want};
 

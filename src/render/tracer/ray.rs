@@ -46,6 +46,45 @@ pub struct RayStats {
     pub hit_halvings: u32,
     /// The ray ran out of steps (counted as a miss).
     pub exhausted: bool,
+    /// Its full evaluations by the value they returned (`render --stats`).
+    pub by_value: ByValue,
+}
+
+/// Upper edges of the bins of [`ByValue`], in epsilons: the bins are `(-inf, 0)`, `[0,
+/// 1)`, `[1, 2)`, ... `[32, 64)` and `[64, inf)` (NaN and `+inf` in the last).
+pub const VALUE_EDGES: [f64; 8] = [0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0];
+
+/// Bins of [`ByValue`].
+pub const VALUE_BINS: usize = VALUE_EDGES.len() + 1;
+
+/// Full evaluations by the value they returned, in epsilons, and the leaves they
+/// visited; apart, the evaluations that only took a hit's gradient (no value). Where a
+/// ray's work goes: at values far above the band a full evaluation only takes a step
+/// (doc/performance-log.md, round thirty-four).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ByValue {
+    pub evals: [u32; VALUE_BINS],
+    pub leaves: [u32; VALUE_BINS],
+    pub gradient_evals: u32,
+    pub gradient_leaves: u32,
+}
+
+impl ByValue {
+    /// The bin of a value of `v` epsilons.
+    pub fn bin(v: f64) -> usize {
+        VALUE_EDGES
+            .iter()
+            .take_while(|&&e| v >= e || v.is_nan())
+            .count()
+    }
+
+    /// Counts a full evaluation that returned `v` epsilons after visiting `leaves`.
+    #[inline]
+    pub fn add(&mut self, v: f64, leaves: u32) {
+        let b = Self::bin(v);
+        self.evals[b] += 1;
+        self.leaves[b] += leaves;
+    }
 }
 
 /// The result of tracing one ray.
@@ -53,4 +92,26 @@ pub struct RayStats {
 pub struct RayResult {
     pub hit: Option<Hit>,
     pub stats: RayStats,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_fall_in_the_bin_their_edges_bound() {
+        assert_eq!(ByValue::bin(-0.5), 0);
+        assert_eq!(ByValue::bin(f64::NEG_INFINITY), 0);
+        assert_eq!(ByValue::bin(0.0), 1);
+        assert_eq!(ByValue::bin(0.99), 1);
+        assert_eq!(ByValue::bin(1.0), 2);
+        assert_eq!(ByValue::bin(20.0), 6);
+        assert_eq!(ByValue::bin(64.0), VALUE_BINS - 1);
+        assert_eq!(ByValue::bin(f64::INFINITY), VALUE_BINS - 1);
+        assert_eq!(ByValue::bin(f64::NAN), VALUE_BINS - 1);
+        let mut b = ByValue::default();
+        b.add(3.0, 10);
+        b.add(3.5, 5);
+        assert_eq!((b.evals[3], b.leaves[3]), (2, 15));
+    }
 }

@@ -124,6 +124,8 @@ impl<'a> Tracer<'a> {
             );
             stats.evals += 1;
             stats.eval.add(&sample.stats);
+            stats.by_value.gradient_evals += 1;
+            stats.by_value.gradient_leaves += sample.stats.leaves();
             if sample.s.is_finite() || alpha <= 1e-300 {
                 return sample.grad;
             }
@@ -246,6 +248,9 @@ impl<'a> Tracer<'a> {
                 } else {
                     stats.evals += 1;
                     stats.step_evals += u32::from(!accurate && beta > obj.params.beta);
+                    stats
+                        .by_value
+                        .add(sample.s / self.options.epsilon, sample.stats.leaves());
                 }
                 stats.eval.add(&sample.stats);
                 sample
