@@ -233,6 +233,14 @@ mod tests {
                 let (idx, mu) = grid.cone(u);
                 let back: DVec3 = (0..3).map(|k| mu[k] * grid.direction(idx[k])).sum();
                 assert!((back - u).length() < 1e-12, "n {n}: {u} rebuilt as {back}");
+                // The same cone from the direction unnormalised, with its length.
+                let len = 3.7e-3;
+                let (idx_of, mu_of) = grid.cone_of(u * len, len);
+                let back_of: DVec3 = (0..3).map(|k| mu_of[k] * grid.direction(idx_of[k])).sum();
+                assert!(
+                    (back_of - u).length() < 1e-12,
+                    "n {n}: {u} unnormalised rebuilt as {back_of}"
+                );
                 assert!(mu.iter().all(|&m| m >= 0.0));
                 let m: f64 = mu.iter().sum();
                 assert!(
