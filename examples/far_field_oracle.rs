@@ -46,20 +46,33 @@
 //! - `grid, ends' weight + axis-bin bumps`: that plus, per bin of edge directions (one
 //!   per pair of opposite points of a 9 x 9 grid, 33 axes), the bumps' weighted support
 //!   on the grid where the bin's axis passes the test widened by its edges' largest
-//!   angle to it (certain; the tables a walk could read).
+//!   angle to it (certain; the tables a walk could read);
+//! - `grid, ends' weight + bumps where inside`: the ends' weight's grid table plus `b`
+//!   for each edge that the query projects inside (`0 < t < 1`, one dot product per
+//!   edge; elsewhere the closest point is an end, whose weight the table holds):
+//!   certain, at the cost of a test per edge of the far subtree (doc/performance-log.md,
+//!   round thirty-four);
+//! - `directional, closest feature's weight`: the directional distance with the largest
+//!   weight of the feature (corner, edge or face; an edge's end or inside) that holds the
+//!   primitive's closest point, as a test of where the query projects would know it
+//!   (sampled maxima, as the cone weights).
 //!
 //! The weights' maxima over an edge or a face are sampled (17 points per edge, 66 per
 //! face, 91 per primitive for the weighted support), not bounded: these are
 //! measurements of what a bound could reach, not bounds. Except in the grid's tables
 //! on edges: there the weighted support is certain (`primitives::support`, 32 pieces per
 //! edge, the weight quartic's maximum on each from its critical points).
-//! Printed per beta: leaves (exact terms plus far terms) per point and the median and
+//! Printed per beta: leaves (exact terms plus far terms) per point, the primitives
+//! below the far terms within reach of the nearest distance (`alpha (r - d_min) <= 2 +
+//! ln(n w_max)`, as the walk reads the tables: what a far term that tests each primitive
+//! would read), and the median and
 //! 90th percentile of each sum's deficit below the exact value, in epsilons.
 //!
 //! `cargo run --release --example far_field_oracle -- SCENE [STEP] [WIDEN] [BETAS]`
 //! (defaults 7, 0, `0.35,0.5,0.7,1`).
 use glam::DVec3;
 use smoothtrace::bvh::Node;
+use smoothtrace::geometry::closest::{TriFeature, closest_on_triangle};
 use smoothtrace::geometry::directions::DirectionGrid;
 use smoothtrace::primitives::directional::lse;
 use smoothtrace::primitives::support::{edge_piece_log_weights, edge_weighted_support};
@@ -71,7 +84,7 @@ use smoothtrace::reports::quantile;
 use smoothtrace::scene::Scene;
 use std::path::Path;
 
-const NAMES: [&str; 13] = [
+const NAMES: [&str; 15] = [
     "box, max weight",
     "box, actual weights",
     "box, cone weights",
@@ -85,6 +98,8 @@ const NAMES: [&str; 13] = [
     "split, right-angle bumps (edges)",
     "grid, ends' weight alone (edges)",
     "grid, ends' weight + axis-bin bumps (edges)",
+    "grid, ends' weight + bumps where inside (edges)",
+    "directional, closest feature's weight",
 ];
 
 /// The side of the grid whose points give the bump bins' axes (33 axes).
@@ -108,6 +123,11 @@ struct Shape {
 trait Vertices: Primitive {
     fn vertices(&self) -> [DVec3; 3];
 
+    /// The largest weight of the feature (vertex, edge or face) holding the closest
+    /// point to `x`, from the shape's sampled maxima: what a test of where `x` projects
+    /// can know without the weight itself.
+    fn feature_weight(&self, s: &Shape, x: DVec3) -> f64;
+
     /// Certain upper bounds of `max over p of alpha g . p + ln w(p)`, one per direction
     /// `g` of `dirs` (`None`: only sampled for this kind).
     fn certain_supports(
@@ -130,11 +150,33 @@ impl Vertices for Triangle {
     fn vertices(&self) -> [DVec3; 3] {
         [self.a.as_dvec3(), self.b.as_dvec3(), self.c.as_dvec3()]
     }
+
+    fn feature_weight(&self, s: &Shape, x: DVec3) -> f64 {
+        let [a, b, c] = self.vertices();
+        match closest_on_triangle(x, a, b, c).feature {
+            TriFeature::VertexA | TriFeature::VertexB | TriFeature::VertexC => s.w_vertex,
+            TriFeature::EdgeAB => s.w_edge[0],
+            TriFeature::EdgeBC => s.w_edge[1],
+            TriFeature::EdgeAC => s.w_edge[2],
+            TriFeature::Face => s.w_face,
+            TriFeature::Degenerate => s.w_face.max(s.w_edge[0]).max(s.w_edge[1]).max(s.w_edge[2]),
+        }
+    }
 }
 
 impl Vertices for Edge {
     fn vertices(&self) -> [DVec3; 3] {
         [self.a.as_dvec3(), self.b.as_dvec3(), self.b.as_dvec3()]
+    }
+
+    fn feature_weight(&self, s: &Shape, x: DVec3) -> f64 {
+        let (a, e) = (self.a.as_dvec3(), (self.b - self.a).as_dvec3());
+        let t = (x - a).dot(e) / e.length_squared();
+        if t > 0.0 && t < 1.0 {
+            s.w_edge[0]
+        } else {
+            s.w_vertex
+        }
     }
 
     /// `primitives::support`: certain, from 32 pieces of the edge (their weights once).
@@ -265,6 +307,8 @@ struct Oracle<'s, P> {
     /// Edges of far terms, and those whose closest point lies inside them.
     far_edges: std::cell::Cell<usize>,
     inside: std::cell::Cell<usize>,
+    /// Primitives below far terms (what a test per primitive would read).
+    far_prims: std::cell::Cell<usize>,
     /// Far terms whose grid bound fell below their exact sum, and the worst ratio.
     violations: std::cell::Cell<usize>,
     worst: std::cell::Cell<f64>,
@@ -287,14 +331,20 @@ impl<P: Vertices> Oracle<'_, P> {
 
     /// Each bound's sum at `x` for `beta` (NaN for rows that do not apply), the exact
     /// sum, and the leaves.
-    fn sums(&self, x: DVec3, beta: f64) -> ([f64; 13], f64, usize) {
+    fn sums(&self, x: DVec3, beta: f64) -> ([f64; 15], f64, usize) {
         let (nodes, prims, alpha) = (&self.set.bvh.nodes, &self.set.prims, self.alpha);
         let w_max = self.scale.max_weight();
-        let mut sums = [0.0; 13];
+        let mut sums = [0.0; 15];
         if self.split.is_empty() {
-            sums[9..].fill(f64::NAN);
+            sums[9..14].fill(f64::NAN);
         }
         let (mut exact, mut leaves) = (0.0, 0);
+        // The nearest distance, for the far terms within reach of it (those a walk reads
+        // the tables for, `eval::walk`'s `SIGNIFICANT`).
+        let d_min = prims
+            .iter()
+            .map(|p| p.value(x, &self.scale).0)
+            .fold(f64::INFINITY, f64::min);
         let mut stack = vec![0usize];
         while let Some(i) = stack.pop() {
             let n = &nodes[i];
@@ -302,6 +352,10 @@ impl<P: Vertices> Oracle<'_, P> {
             let range = self.start[i]..self.start[i] + n.size as usize;
             if r > 0.0 && (n.diam as f64) < beta * r {
                 leaves += 1;
+                let ln_w = (n.size as f64 * w_max).ln().max(0.0);
+                if alpha * (r - d_min) <= 2.0 + ln_w {
+                    self.far_prims.set(self.far_prims.get() + n.size as usize);
+                }
                 let count = n.size as f64;
                 let boxed = (-alpha * r).exp();
                 let c = 0.5 * (n.min.as_dvec3() + n.max.as_dvec3());
@@ -335,7 +389,7 @@ impl<P: Vertices> Oracle<'_, P> {
                 if !self.split.is_empty() {
                     // The bump counts where the edge is seen at nearly a right angle.
                     let right = 0.5 * n.diam as f64 / l;
-                    let (mut oracle, mut certain) = (0.0, 0.0);
+                    let (mut oracle, mut certain, mut inside_bumps) = (0.0, 0.0, 0.0);
                     for k in range.clone() {
                         let (w_e, b) = self.split[k];
                         let v = edge_ends(&self.shapes[k]);
@@ -351,6 +405,7 @@ impl<P: Vertices> Oracle<'_, P> {
                         let t = (x - a).dot(e) / e.length_squared();
                         self.far_edges.set(self.far_edges.get() + 1);
                         if t > 0.0 && t < 1.0 {
+                            inside_bumps += b * dir;
                             self.inside.set(self.inside.get() + 1);
                             let (d, w) = prims[k].value(x, &self.scale);
                             oracle += (w - w_e).max(0.0) * (-alpha * d).exp();
@@ -370,6 +425,10 @@ impl<P: Vertices> Oracle<'_, P> {
                         .map(|(_, _, t)| (-alpha * l + self.on_grid(t, u, c)).exp())
                         .sum();
                     sums[12] += (ends + bumps).min(box_term);
+                    // Where the query projects inside an edge (a test per edge, certain),
+                    // its bump above the ends' weight; elsewhere the closest point is an
+                    // end, whose weight the ends' table holds.
+                    sums[13] += (ends + inside_bumps).min(box_term);
                 }
                 let (mut moment_var, mut moment_z, mut rho_max) = (0.0, 0.0f64, 0.0f64);
                 let mean: DVec3 = range
@@ -389,6 +448,7 @@ impl<P: Vertices> Oracle<'_, P> {
                     part[3] += w_max * dir;
                     part[4] += wc * dir;
                     part[5] += w * dir;
+                    part[7] += prims[k].feature_weight(s, x) * dir;
                     let weighted = (0..=12)
                         .flat_map(|i| (0..=(12 - i)).map(move |j| (i, j)))
                         .map(|(i, j)| {
@@ -415,6 +475,7 @@ impl<P: Vertices> Oracle<'_, P> {
                 sums[4] += part[4].min(part[2] * boxed);
                 sums[5] += part[5].min(part[1] * boxed);
                 sums[6] += part[6].min(box_term);
+                sums[14] += part[7].min(box_term);
                 let g = if moment_z < 1e-9 {
                     0.5
                 } else {
@@ -602,6 +663,7 @@ fn run<P: Vertices>(
         bump_bins,
         far_edges: Default::default(),
         inside: Default::default(),
+        far_prims: Default::default(),
         violations: Default::default(),
         worst: std::cell::Cell::new(1.0),
         grid,
@@ -616,6 +678,7 @@ fn run<P: Vertices>(
     for &beta in betas {
         oracle.far_edges.set(0);
         oracle.inside.set(0);
+        oracle.far_prims.set(0);
         let mut deficits: Vec<Vec<f64>> = vec![Vec::new(); NAMES.len()];
         let mut leaves = 0;
         for &x in points {
@@ -627,8 +690,9 @@ fn run<P: Vertices>(
             }
         }
         println!(
-            "beta {beta}: {:.0} leaves per point; grid bound below the exact sum: {} far terms (worst by {:.3e})",
+            "beta {beta}: {:.0} leaves per point ({:.0} primitives below far terms within reach); grid bound below the exact sum: {} far terms (worst by {:.3e})",
             leaves as f64 / points.len() as f64,
+            oracle.far_prims.get() as f64 / points.len() as f64,
             oracle.violations.get(),
             oracle.worst.get() - 1.0
         );
