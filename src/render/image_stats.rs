@@ -185,47 +185,52 @@ impl ImageStats {
     }
 
     pub fn evals_per_ray(&self) -> f64 {
-        self.evals as f64 / self.rays.max(1) as f64
+        per(self.evals, self.rays)
     }
     /// Full-accuracy evaluations per ray that hit.
     pub fn evals_per_hit(&self) -> f64 {
-        self.hit_evals as f64 / self.hits.max(1) as f64
+        per(self.hit_evals, self.hits)
     }
     /// Full evaluations per ray that hit that only took a step at the coarser step beta
     /// (part of [`ImageStats::evals_per_hit`]).
     pub fn step_evals_per_hit(&self) -> f64 {
-        self.hit_step_evals as f64 / self.hits.max(1) as f64
+        per(self.hit_step_evals, self.hits)
     }
     /// Bound steps (coarse evaluations) per ray that hit, its own only: the tile
     /// marches it shared are counted in [`ImageStats::tile_evals_per_ray`].
     pub fn bound_evals_per_hit(&self) -> f64 {
-        self.hit_coarse_evals as f64 / self.hits.max(1) as f64
+        per(self.hit_coarse_evals, self.hits)
     }
     /// Bound steps per ray, the tile marches included.
     pub fn bound_evals_per_ray(&self) -> f64 {
-        self.coarse_evals as f64 / self.rays.max(1) as f64
+        per(self.coarse_evals, self.rays)
     }
     /// Tile-march evaluations per ray (each shared by a tile's rays).
     pub fn tile_evals_per_ray(&self) -> f64 {
-        self.tile_evals as f64 / self.rays.max(1) as f64
+        per(self.tile_evals, self.rays)
     }
     /// Leaves visited per ray that hit, its own evaluations only.
     pub fn leaves_per_hit(&self) -> f64 {
-        self.hit_leaves as f64 / self.hits.max(1) as f64
+        per(self.hit_leaves, self.hits)
     }
     /// Leaves per evaluation, coarse and fine together.
     pub fn leaves_per_eval(&self) -> f64 {
-        self.leaves as f64 / (self.evals + self.coarse_evals).max(1) as f64
+        per(self.leaves, self.evals + self.coarse_evals)
     }
     /// Leaves visited per ray: the total work.
     pub fn leaves_per_ray(&self) -> f64 {
-        self.leaves as f64 / self.rays.max(1) as f64
+        per(self.leaves, self.rays)
     }
     /// Rays per rendered pixel.
     pub fn samples_per_pixel(&self) -> f64 {
-        self.rays as f64 / self.pixels.max(1) as f64
+        per(self.rays, self.pixels)
     }
     pub fn rays_per_second(&self) -> f64 {
         self.rays as f64 / self.seconds.max(1e-12)
     }
+}
+
+/// `n / d` as a ratio, 0 when `d` is 0 (an image with no rays, hits or evaluations).
+fn per(n: u64, d: u64) -> f64 {
+    n as f64 / d.max(1) as f64
 }
