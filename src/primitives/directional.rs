@@ -15,8 +15,14 @@
 //! f32). The values are summed about the origin up the tree by log-sum-exp and moved to
 //! each entry's centre at the end: `alpha s_T(v)` about `c` is the value about the origin
 //! minus `alpha v . c`.
+//!
+//! An edge set's tables also carry a second table of the same layout, its ends' weight's,
+//! with what a far term needs to add the bumps inside the edges `x` projects inside
+//! (`primitives::split`, round thirty-five): the walk takes that split bound where it is
+//! the smaller.
 
 use super::kinds::{Edge, Triangle};
+use super::split::{SplitTables, edge_splits, ends_supports};
 use super::support::{SupportEnvelope, piece_log_weights};
 use super::triangle_support::TriangleLattice;
 use super::weights::WeightScale;
@@ -48,6 +54,8 @@ pub struct DirectionalTables {
     pub q: f64,
     /// Per wide node and entry, the grid's values then the value at 0.
     values: Vec<f32>,
+    /// Edges: their weights split into the ends' and the bumps (`primitives::split`).
+    split: Option<SplitTables>,
 }
 
 /// Per value, `ln sum exp` over the tables, shifted by the largest (`-inf` for none);
@@ -127,9 +135,15 @@ impl DirectionalTables {
             |e| (e.val_a, e.val_b),
             |e| SupportEnvelope::new(&piece_log_weights(e.val_a, e.val_b, scale)),
         );
-        Self::build(wide, alpha, scale, |p, dirs| {
+        let mut tables = Self::build(wide, alpha, scale, |p, dirs| {
             envelopes[envelope_of[p] as usize].supports(&prims[p], dirs, alpha)
-        })
+        });
+        let splits = edge_splits(prims, scale);
+        let ends = Self::build(wide, alpha, scale, |p, dirs| {
+            ends_supports(&prims[p], splits[p].0, dirs, alpha)
+        });
+        tables.split = Some(SplitTables::new(prims, wide, &splits, ends.values));
+        tables
     }
 
     /// The tables of a triangle set, as [`DirectionalTables::for_edges`].
@@ -251,6 +265,7 @@ impl DirectionalTables {
             alpha,
             q: scale.q,
             values,
+            split: None,
         }
     }
 
@@ -263,15 +278,57 @@ impl DirectionalTables {
         if l.is_nan() || l == 0.0 {
             return None;
         }
-        let t = &self.values[(i * ENTRIES + e) * VALUES..(i * ENTRIES + e + 1) * VALUES];
-        let (idx, mu) = self.grid.cone_of(v, l);
+        Some((l, self.on_grid(&self.values, i, e, self.grid.cone_of(v, l))))
+    }
+
+    /// [`DirectionalTables::bound`], with the ends' table's value where the set has a
+    /// split (edges, `primitives::split`): `(|x - c|, ln of the weight, ln of the ends'
+    /// weight)`.
+    pub fn bounds(
+        &self,
+        i: usize,
+        e: usize,
+        c: DVec3,
+        x: DVec3,
+    ) -> Option<(f64, f64, Option<f64>)> {
+        let v = x - c;
+        let l = v.length();
+        if l.is_nan() || l == 0.0 {
+            return None;
+        }
+        let cone = self.grid.cone_of(v, l);
+        let d = self.on_grid(&self.values, i, e, cone);
+        let ends = self
+            .split
+            .as_ref()
+            .map(|s| self.on_grid(&s.ends, i, e, cone));
+        Some((l, d, ends))
+    }
+
+    /// The edges' split (`primitives::split`), if these are an edge set's tables.
+    pub fn split(&self) -> Option<&SplitTables> {
+        self.split.as_ref()
+    }
+
+    /// Entry `e` of wide node `i` in `values` (a table's layout) at the direction of
+    /// `cone` (`DirectionGrid::cone_of`): bounded by convexity between the grid's values
+    /// and the value at 0.
+    #[inline(always)]
+    fn on_grid(
+        &self,
+        values: &[f32],
+        i: usize,
+        e: usize,
+        (idx, mu): ([usize; 3], [f64; 3]),
+    ) -> f64 {
+        let t = &values[(i * ENTRIES + e) * VALUES..(i * ENTRIES + e + 1) * VALUES];
         let s = self.grid.scale();
         let m: f64 = mu.iter().sum();
         let mut d = (1.0 - m / s).max(0.0) * t[VALUES - 1] as f64;
         for k in 0..3 {
             d += mu[k] / s * t[idx[k]] as f64;
         }
-        Some((l, d))
+        d
     }
 }
 
@@ -346,6 +403,8 @@ mod tests {
         tables: impl Fn(f64, &WeightScale) -> DirectionalTables,
     ) {
         for (alpha, max_alpha) in [(20.0, 40.0), (150.0, 100.0)] {
+            // Entries whose split bound is below the table's (edges).
+            let mut tighter = 0;
             let scale = WeightScale::new(set.max_adj, alpha, max_alpha);
             let tables = tables(alpha, &scale);
             for _ in 0..40 {
@@ -370,8 +429,43 @@ mod tests {
                             bound >= exact * (1.0 - 1e-9),
                             "node {i} entry {e}: bound {bound} below the exact {exact}"
                         );
+                        // Edges: the split bound too, over the entry's range (which must
+                        // hold its primitives: the same exact sum).
+                        let (Some(split), Some((_, _, Some(d_ends)))) =
+                            (tables.split(), tables.bounds(i, e, c, x))
+                        else {
+                            continue;
+                        };
+                        let range = split.range(node, e);
+                        let in_range: f64 = set.prims[range.clone()]
+                            .iter()
+                            .map(|p| {
+                                let (d, w) = p.value(x, &scale);
+                                w * (-alpha * d).exp()
+                            })
+                            .sum();
+                        assert!(
+                            (in_range - exact).abs() <= 1e-12 * exact,
+                            "node {i} entry {e}: its range sums {in_range}, its slots {exact}"
+                        );
+                        let ds = split.bound(range, x, (c, l), (d_ends, d), alpha);
+                        let split_bound = (-alpha * l + ds).exp();
+                        assert!(
+                            ds <= d && split_bound >= exact * (1.0 - 1e-9),
+                            "node {i} entry {e}: split bound {split_bound} below the exact \
+                             {exact} (or above the table's {bound})"
+                        );
+                        if ds < d - 1e-9 {
+                            tighter += 1;
+                        }
                     }
                 }
+            }
+            if tables.split().is_some() {
+                assert!(
+                    tighter > 0,
+                    "no split bound below the table's at alpha {alpha}"
+                );
             }
         }
     }

@@ -8,6 +8,7 @@ pub mod directional;
 mod kinds;
 pub mod lanes;
 mod sets;
+pub mod split;
 pub mod support;
 pub mod triangle_support;
 pub mod weights;

@@ -131,10 +131,11 @@ macro_rules! with_set {
 /// default, `bvh::BuildOptions`). A leaf is never a far-field term, and an edge's far
 /// term is loose: it charges every edge the weight its middle has, where a query's
 /// closest point is mostly an end, of a smaller weight (doc/performance-log.md, round
-/// thirty-one). With larger leaves the groups near a query are summed exactly, the hits
-/// at 0.8 of beta (`TracerOptions::hit_beta_scale_edges`) stay closer to the exact
-/// surface than at 0.6 with leaves of four, and the walk, four edges to an AVX batch,
-/// is faster (round thirty-two).
+/// thirty-one; round thirty-five split it, `primitives::split`). With larger leaves the
+/// groups near a query are summed exactly, the hits at 0.8 of beta (as then,
+/// `TracerOptions::hit_beta_scale_edges`) stayed closer to the exact surface than at
+/// 0.6 with leaves of four, and the walk, four edges to an AVX batch, is faster (round
+/// thirty-two).
 pub const EDGE_LEAF_SIZE: usize = 8;
 
 impl AnySet {

@@ -60,6 +60,23 @@ pub fn piece_log_weights(val_a: f32, val_b: f32, scale: &WeightScale) -> [f64; E
     })
 }
 
+/// An edge's weight split into its ends' weight and the bump above it inside the edge:
+/// `(ln w_E, b)` with `w_E` the larger of the weights at its two ends (the weight wherever
+/// the closest point is an end) and `b >= 0` such that `w_E + b` is at least the weight
+/// anywhere inside the edge (from the pieces' certain maxima, [`piece_log_weights`]).
+/// `ln w_E` is rounded up; `b` covers the rest of the rounding.
+pub fn edge_split(val_a: f32, val_b: f32, scale: &WeightScale) -> (f64, f64) {
+    let c = edge_quartic(1.0 / val_a as f64, 1.0 / val_b as f64);
+    let raw = edge_w(0.0, c).0.max(edge_w(1.0, c).0);
+    let w_e = scale.weight(raw * (1.0 + 1e-12) + 1e-15);
+    let peak = piece_log_weights(val_a, val_b, scale)
+        .into_iter()
+        .fold(f64::NEG_INFINITY, f64::max)
+        .exp()
+        * (1.0 + 1e-12);
+    (w_e.ln() * (1.0 + 1e-12) + 1e-15, (peak - w_e).max(0.0))
+}
+
 /// The weighted support of `e` in direction `g` (any length) at sharpness `alpha`, from
 /// its pieces' log-weights ([`edge_piece_log_weights`]): at least `alpha g . p + ln w(p)`
 /// at every point `p` of the edge.

@@ -45,11 +45,14 @@ pub struct TracerOptions {
     /// round twenty-nine gave triangles the directional far field). Not with certified
     /// hits, which start from `hit_beta_scale`.
     pub hit_beta_scale_soft_triangles: f64,
-    /// The same for objects made of edges alone, at any `alpha`: their leaves hold
-    /// eight edges (`primitives::EDGE_LEAF_SIZE`), summed exactly near a query, and at
-    /// 0.8 their hits stay closer to the exact surface than at 0.6 with leaves of four
-    /// (doc/performance-log.md, round thirty-two). Not with certified hits, which start
-    /// from `hit_beta_scale`.
+    /// The same for objects made of edges alone, at any `alpha`: their far terms split
+    /// each edge's weight into its ends' and the bump inside it (`primitives::split`),
+    /// and at 0.99 their hits stay closer to the exact surface than they did at 0.8
+    /// with the directional tables alone, with fewer leaves (doc/performance-log.md,
+    /// round thirty-five; 0.8 from round thirty-two). Just below 1, not 1: the hits stay
+    /// decided by the tracer's devices for a hit beta finer than the scene's (`sticky`
+    /// evaluations, hits from above the band: `render::tracer`, items 9 and 13). Not
+    /// with certified hits, which start from `hit_beta_scale`.
     pub hit_beta_scale_edges: f64,
     /// Evaluations at the hit beta on edges and triangles also take a subtree as one
     /// far-field term when its bound is at most `far_share alpha epsilon` of the sum
@@ -120,7 +123,7 @@ impl TracerOptions {
             relax: true,
             hit_beta_scale: 0.6,
             hit_beta_scale_soft_triangles: 0.8,
-            hit_beta_scale_edges: 0.8,
+            hit_beta_scale_edges: 0.99,
             far_share: FAR_SHARE,
             step_beta: 1.0,
             learn_step_beta: true,

@@ -123,6 +123,23 @@ impl F {
         unsafe { _mm256_storeu_pd(o.as_mut_ptr(), self.0) };
         o
     }
+    /// The lanes' sign bits, lane 0 lowest (of a comparison's mask: where it holds).
+    #[inline(always)]
+    pub(super) fn mask(self) -> u32 {
+        // SAFETY: called only from the AVX kernels.
+        unsafe { _mm256_movemask_pd(self.0) as u32 }
+    }
+    /// Each lane's absolute value.
+    #[inline(always)]
+    pub(super) fn abs(self) -> F {
+        // SAFETY: called only from the AVX kernels.
+        F(unsafe { _mm256_andnot_pd(_mm256_set1_pd(-0.0), self.0) })
+    }
+    /// Where `self < o` (all bits set).
+    #[inline(always)]
+    pub(super) fn lt(self, o: F) -> F {
+        self.cmp::<_CMP_LT_OQ>(o)
+    }
     #[inline(always)]
     pub(super) fn sqrt(self) -> F {
         // SAFETY: called only from the AVX kernels.

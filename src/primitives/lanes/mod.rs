@@ -24,6 +24,8 @@ use glam::DVec3;
 mod avx;
 #[cfg(target_arch = "x86_64")]
 mod edges;
+#[cfg(target_arch = "x86_64")]
+mod slabs;
 
 /// Setting this environment variable (to anything) keeps every term on the scalar
 /// path: for profilers that cannot decode AVX (valgrind 3.19), and for comparisons.
@@ -90,4 +92,56 @@ pub fn edge_values(e: &EdgeLanes, x: DVec3, scale: &WeightScale) -> Option<(Lane
     }
     let _ = (e, x, scale);
     None
+}
+
+/// Edges' slabs in structure-of-arrays form (`primitives::split`): per edge its midpoint
+/// `m` and `n = (b - a) / |b - a|^2` (0 for an empty edge), coordinate by coordinate, so
+/// that `n . (x - m)` lies in `(-1/2, 1/2)` exactly where `x` projects inside the edge.
+#[derive(Clone, Debug, Default)]
+pub struct Slabs {
+    pub m: [Vec<f64>; 3],
+    pub n: [Vec<f64>; 3],
+}
+
+impl Slabs {
+    /// `n . (x - m)` of edge `k`, in the order the lanes compute it.
+    #[inline(always)]
+    pub fn projection(&self, k: usize, x: DVec3) -> f64 {
+        let (m, n) = (&self.m, &self.n);
+        n[0][k] * (x.x - m[0][k]) + n[1][k] * (x.y - m[1][k]) + n[2][k] * (x.z - m[2][k])
+    }
+
+    /// Calls `inside(k)` for each edge `k` of `range`, in order, whose projection
+    /// ([`Slabs::projection`]) is below `lim` in size, until it returns `false`; returns
+    /// whether every call returned `true`. Four edges at a time on AVX, with the same
+    /// arithmetic.
+    #[inline]
+    pub fn scan(
+        &self,
+        range: std::ops::Range<usize>,
+        x: DVec3,
+        lim: f64,
+        inside: impl FnMut(usize) -> bool,
+    ) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if available() {
+            // SAFETY: AVX was detected.
+            return unsafe { slabs::scan(self, range, x, lim, inside) };
+        }
+        self.scan_scalar(range, x, lim, inside)
+    }
+
+    /// [`Slabs::scan`] one edge at a time.
+    #[inline]
+    pub fn scan_scalar(
+        &self,
+        range: std::ops::Range<usize>,
+        x: DVec3,
+        lim: f64,
+        inside: impl FnMut(usize) -> bool,
+    ) -> bool {
+        range
+            .filter(|&k| self.projection(k, x).abs() < lim)
+            .all(inside)
+    }
 }

@@ -78,10 +78,11 @@
 //!    scene's, 0.6 by default; 0.8, `hit_beta_scale_soft_triangles`, for soft fields
 //!    over triangle meshes, `TraceObject::soft_triangles`, where with the directional
 //!    far field it keeps the hits within the accuracy goals with a quarter fewer leaves:
-//!    doc/performance-log.md, rounds twenty-one and twenty-nine; 0.8 too,
-//!    `hit_beta_scale_edges`, for objects made of edges alone, whose leaves of eight
-//!    edges, summed exactly, keep the hits closer to the exact surface than leaves of
-//!    four at 0.6: round thirty-two): the Barnes-Hut sum is a lower bound of the exact one,
+//!    doc/performance-log.md, rounds twenty-one and twenty-nine; 0.99,
+//!    `hit_beta_scale_edges`, for objects made of edges alone, whose far terms split
+//!    each edge's weight into its ends' and the bump inside it (`primitives::split`) and
+//!    keep the hits closer to the exact surface there than the directional tables alone
+//!    did at 0.8: round thirty-five): the Barnes-Hut sum is a lower bound of the exact one,
 //!    but where `alpha` times the size of far-field nodes is large (soft point clouds,
 //!    dense edge meshes at small `alpha`) it can be many epsilons low, and a ray that
 //!    stops where it drops below epsilon stops short of the exact surface. Evaluations
