@@ -445,18 +445,14 @@ impl<'w, 'a, P: Primitive, const GRAD: bool, const SLOPE: bool, const SHARE: boo
             if near.0 < reach * reach {
                 let node = &self.set.bvh.wide[i as usize];
                 let c = entry_centre(node, e);
-                let bound = match t.split() {
-                    None => t.bound(i as usize, e, c, self.x),
+                if let Some((l, d, ends)) = t.bounds(i as usize, e, c, self.x) {
                     // Edges: the split bound where it is the smaller (`primitives::split`).
-                    Some(s) => t.bounds(i as usize, e, c, self.x).map(|(l, d, d_ends)| {
-                        let d_ends = d_ends.unwrap_or(d);
-                        (
-                            l,
-                            s.bound(s.range(node, e), self.x, (c, l), (d_ends, d), t.alpha),
-                        )
-                    }),
-                };
-                if let Some((l, d)) = bound {
+                    let d = match (ends, t.split()) {
+                        (Some(d_ends), Some(s)) => {
+                            s.bound(s.range(node, e), self.x, (c, l), (d_ends, d), t.alpha)
+                        }
+                        _ => d,
+                    };
                     let alpha = t.alpha;
                     // The smaller of the two bounds (either holds; `ln_w` is at least
                     // `ln w`).

@@ -22,8 +22,8 @@
 //! the smaller.
 
 use super::kinds::{Edge, Triangle};
-use super::split::{SplitTables, edge_splits, ends_supports};
-use super::support::{SupportEnvelope, piece_log_weights};
+use super::split::{SplitTables, ends_supports};
+use super::support::{SupportEnvelope, edge_split, piece_log_weights};
 use super::triangle_support::TriangleLattice;
 use super::weights::WeightScale;
 use crate::bvh::Node4;
@@ -138,7 +138,13 @@ impl DirectionalTables {
         let mut tables = Self::build(wide, alpha, scale, |p, dirs| {
             envelopes[envelope_of[p] as usize].supports(&prims[p], dirs, alpha)
         });
-        let splits = edge_splits(prims, scale);
+        // Each edge's split (`support::edge_split`), one per pair of end valences.
+        let (pairs, pair_of) = per_valence_pair(
+            prims,
+            |e| (e.val_a, e.val_b),
+            |e| edge_split(e.val_a, e.val_b, scale),
+        );
+        let splits: Vec<(f64, f64)> = pair_of.iter().map(|&k| pairs[k as usize]).collect();
         let ends = Self::build(wide, alpha, scale, |p, dirs| {
             ends_supports(&prims[p], splits[p].0, dirs, alpha)
         });
@@ -273,12 +279,7 @@ impl DirectionalTables {
     /// [`entry_centre`]) at `x`, as `(|x - c|, ln of the weight)`: the terms sum to at
     /// most `exp(-alpha |x - c|)` times that weight. `None` at the centre.
     pub fn bound(&self, i: usize, e: usize, c: DVec3, x: DVec3) -> Option<(f64, f64)> {
-        let v = x - c;
-        let l = v.length();
-        if l.is_nan() || l == 0.0 {
-            return None;
-        }
-        Some((l, self.on_grid(&self.values, i, e, self.grid.cone_of(v, l))))
+        self.bounds(i, e, c, x).map(|(l, d, _)| (l, d))
     }
 
     /// [`DirectionalTables::bound`], with the ends' table's value where the set has a

@@ -32,8 +32,6 @@
 
 use super::kinds::Edge;
 use super::lanes::Slabs;
-use super::support::edge_split;
-use super::weights::WeightScale;
 use crate::bvh::Node4;
 use crate::bvh::moments::MIDDLE;
 use crate::bvh::wide::EMPTY;
@@ -62,25 +60,11 @@ pub struct SplitTables {
     slabs: Slabs,
     /// Per wide node: its first edge.
     first: Vec<u32>,
-    /// The largest `|n|`, and the centre and half diagonal of the edges' box: `|x - m|`
-    /// is at most `|x - centre| + half_diag`.
-    n_max: f64,
+    /// The centre of the edges' box, and the squared distance from it within which
+    /// `|n| |x - m| <= REACH_MAX` for every edge: `|x - m|` is at most `|x - centre|`
+    /// plus the box's half diagonal, `|n|` at most the largest.
     centre: DVec3,
-    half_diag: f64,
-}
-
-/// Per edge, its ends' log-weight `ln w_E` (rounded up) and its bump (module docs), one
-/// split per pair of end valences.
-pub fn edge_splits(prims: &[Edge], scale: &WeightScale) -> Vec<(f64, f64)> {
-    let mut made: std::collections::HashMap<(u32, u32), (f64, f64)> = Default::default();
-    prims
-        .iter()
-        .map(|e| {
-            *made
-                .entry((e.val_a.to_bits(), e.val_b.to_bits()))
-                .or_insert_with(|| edge_split(e.val_a, e.val_b, scale))
-        })
-        .collect()
+    reach2: f64,
 }
 
 /// The weighted support of an edge of constant log-weight `ln_w` in each of the
@@ -95,8 +79,8 @@ pub fn ends_supports<const N: usize>(e: &Edge, ln_w: f64, g: &[DVec3; N], alpha:
 }
 
 impl SplitTables {
-    /// The split of `prims` (in the tree's order; `splits` from [`edge_splits`]) over the
-    /// wide nodes `wide`, with its ends' table `ends`.
+    /// The split of `prims` (in the tree's order; per edge `(ln w_E, b)` from
+    /// `support::edge_split`) over the wide nodes `wide`, with its ends' table `ends`.
     pub fn new(prims: &[Edge], wide: &[Node4], splits: &[(f64, f64)], ends: Vec<f32>) -> Self {
         let mut slabs = Slabs::default();
         let mut len2 = Vec::with_capacity(prims.len());
@@ -115,15 +99,15 @@ impl SplitTables {
             n_max = n_max.max(n.length());
             (lo, hi) = (lo.min(a.min(b)), hi.max(a.max(b)));
         }
+        let reach = (REACH_MAX / n_max - 0.5 * (hi - lo).length()).max(0.0);
         SplitTables {
             ends,
             bumps: splits.iter().map(|s| s.1).collect(),
             len2,
             slabs,
             first: first_primitives(wide),
-            n_max,
             centre: 0.5 * (lo + hi),
-            half_diag: 0.5 * (hi - lo).length(),
+            reach2: reach * reach,
         }
     }
 
@@ -159,7 +143,7 @@ impl SplitTables {
     ) -> f64 {
         if d_ends >= d
             || range.len() > MAX_EDGES
-            || ((x - self.centre).length() + self.half_diag) * self.n_max > REACH_MAX
+            || (x - self.centre).length_squared() > self.reach2
         {
             return d;
         }
@@ -215,6 +199,8 @@ fn first_primitives(wide: &[Node4]) -> Vec<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::primitives::support::edge_split;
+    use crate::primitives::weights::WeightScale;
     use crate::primitives::weights::{edge_quartic, edge_w};
     use crate::testing::uniform;
     use glam::Vec3;
