@@ -1,0 +1,131 @@
+//! Depth error of renders against a reference render of the same rays:
+//! `cargo run --release --example depth_error -- REF DIAG FILE...`
+//!
+//! Each depth is either an EXR of `smoothtrace render --depth` (the hit's ray parameter,
+//! `+inf` for misses) or the raw depth of the published renderer's harness (`.bin`:
+//! float32, row-major from the image's top row, `+inf` for misses), whose size is taken
+//! from the first EXR among the arguments or from `--size WxH` before them. For each FILE
+//! it prints, relative to `DIAG` (the scene's diagonal), the median and 99th percentile
+//! of `|t - t_ref|` over rays that hit in both, the signed median of `t - t_ref` (below
+//! zero: in front of the reference), and the pixels whose hit or miss differs from the
+//! reference's. The measurement of doc/measurements.md, "At equal error".
+use std::path::Path;
+
+/// A depth image: width, height and the depths row by row.
+struct Depth {
+    width: usize,
+    height: usize,
+    t: Vec<f64>,
+}
+
+fn read_exr(path: &str) -> Result<Depth, String> {
+    let image = image::open(Path::new(path)).map_err(|e| format!("{path}: {e}"))?;
+    let rgb = image.to_rgb32f();
+    Ok(Depth {
+        width: rgb.width() as usize,
+        height: rgb.height() as usize,
+        t: rgb.pixels().map(|p| f64::from(p.0[0])).collect(),
+    })
+}
+
+fn read_bin(path: &str, (width, height): (usize, usize)) -> Result<Depth, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{path}: {e}"))?;
+    if bytes.len() != width * height * 4 {
+        return Err(format!(
+            "{path}: {} bytes, expected {width} x {height} float32 values ({} bytes); give --size WxH",
+            bytes.len(),
+            width * height * 4
+        ));
+    }
+    let t = bytes
+        .chunks_exact(4)
+        .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
+        .collect();
+    Ok(Depth { width, height, t })
+}
+
+fn run(args: &[String]) -> Result<(), String> {
+    let usage = "usage: depth_error [--size WxH] REF DIAG FILE...";
+    let mut args = args.to_vec();
+    let mut size: Option<(usize, usize)> = None;
+    if args.first().map(String::as_str) == Some("--size") {
+        let text = args.get(1).ok_or(usage)?.clone();
+        let (w, h) = text
+            .split_once('x')
+            .ok_or("--size: expected WxH, e.g. 480x270")?;
+        let parse = |v: &str| {
+            v.parse::<usize>()
+                .map_err(|_| format!("--size: bad number {v}"))
+        };
+        size = Some((parse(w)?, parse(h)?));
+        args.drain(..2);
+    }
+    if args.len() < 3 {
+        return Err(usage.into());
+    }
+    let diag: f64 = args[1]
+        .parse()
+        .ok()
+        .filter(|d: &f64| *d > 0.0 && d.is_finite())
+        .ok_or_else(|| format!("DIAG: expected a positive number, got {}", args[1]))?;
+    let is_exr = |p: &str| p.to_ascii_lowercase().ends_with(".exr");
+    if size.is_none()
+        && let Some(p) = args.iter().find(|p| is_exr(p))
+    {
+        let d = read_exr(p)?;
+        size = Some((d.width, d.height));
+    }
+    let read = |p: &str| match (is_exr(p), size) {
+        (true, _) => read_exr(p),
+        (false, Some(s)) => read_bin(p, s),
+        (false, None) => Err(format!(
+            "{p}: raw depth needs --size WxH or an EXR argument"
+        )),
+    };
+    let reference = read(&args[0])?;
+    println!("reference {}: {} hits", args[0], hits(&reference));
+    for path in &args[2..] {
+        let d = read(path)?;
+        if (d.width, d.height) != (reference.width, reference.height) {
+            return Err(format!(
+                "{path}: {}x{}, the reference is {}x{}",
+                d.width, d.height, reference.width, reference.height
+            ));
+        }
+        let mut abs = Vec::new();
+        let mut signed = Vec::new();
+        let mut mask = 0usize;
+        for (&a, &r) in d.t.iter().zip(&reference.t) {
+            match (a.is_finite(), r.is_finite()) {
+                (true, true) => {
+                    abs.push((a - r).abs() / diag);
+                    signed.push((a - r) / diag);
+                }
+                (false, false) => {}
+                _ => mask += 1,
+            }
+        }
+        let both = abs.len();
+        let q = |v: &mut Vec<f64>, q: f64| smoothtrace::reports::quantile(v, q).unwrap_or(f64::NAN);
+        println!(
+            "{path}: {} hits, {both} in both, hit or miss differs at {mask}; |t - t_ref| / diag median {:.2e} p99 {:.2e}, signed median {:+.2e}",
+            hits(&d),
+            q(&mut abs, 0.5),
+            q(&mut abs, 0.99),
+            q(&mut signed, 0.5),
+        );
+    }
+    Ok(())
+}
+
+fn hits(d: &Depth) -> usize {
+    d.t.iter().filter(|t| t.is_finite()).count()
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if let Err(e) = run(&args) {
+        eprintln!("depth_error: {e}");
+        std::process::exit(2);
+    }
+}
