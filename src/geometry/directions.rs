@@ -146,7 +146,7 @@ impl DirectionGrid {
     /// length. Without branches on the direction (far terms look in every direction, and
     /// a branch on it is a coin toss): both sides of every choice are computed and one is
     /// kept.
-    #[inline]
+    #[inline(always)]
     pub fn cone_of(&self, v: DVec3, l: f64) -> ([usize; 3], [f64; 3]) {
         let a = v.abs();
         let norm1 = a.x + a.y + a.z;

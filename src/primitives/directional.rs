@@ -285,6 +285,7 @@ impl DirectionalTables {
     /// [`DirectionalTables::bound`], with the ends' table's value where the set has a
     /// split (edges, `primitives::split`): `(|x - c|, ln of the weight, ln of the ends'
     /// weight)`.
+    #[inline(always)]
     pub fn bounds(
         &self,
         i: usize,
