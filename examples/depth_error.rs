@@ -8,14 +8,17 @@
 //! it prints, relative to `DIAG` (the scene's diagonal), the median and 99th percentile
 //! of `|t - t_ref|` over rays that hit in both, the signed median of `t - t_ref` (below
 //! zero: in front of the reference), and the pixels whose hit or miss differs from the
-//! reference's. The measurement of doc/measurements.md, "At equal error".
+//! reference's (`reports::compare::compare_depths`, whose tests hold the counts). The
+//! measurement of doc/measurements.md, "At equal error".
+use smoothtrace::reports::compare::compare_depths;
+use smoothtrace::reports::quantile;
 use std::path::Path;
 
 /// A depth image: width, height and the depths row by row.
 struct Depth {
     width: usize,
     height: usize,
-    t: Vec<f64>,
+    t: Vec<f32>,
 }
 
 fn read_exr(path: &str) -> Result<Depth, String> {
@@ -24,7 +27,7 @@ fn read_exr(path: &str) -> Result<Depth, String> {
     Ok(Depth {
         width: rgb.width() as usize,
         height: rgb.height() as usize,
-        t: rgb.pixels().map(|p| f64::from(p.0[0])).collect(),
+        t: rgb.pixels().map(|p| p.0[0]).collect(),
     })
 }
 
@@ -39,7 +42,7 @@ fn read_bin(path: &str, (width, height): (usize, usize)) -> Result<Depth, String
     }
     let t = bytes
         .chunks_exact(4)
-        .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
         .collect();
     Ok(Depth { width, height, t })
 }
@@ -92,27 +95,21 @@ fn run(args: &[String]) -> Result<(), String> {
                 d.width, d.height, reference.width, reference.height
             ));
         }
-        let mut abs = Vec::new();
-        let mut signed = Vec::new();
-        let mut mask = 0usize;
-        for (&a, &r) in d.t.iter().zip(&reference.t) {
-            match (a.is_finite(), r.is_finite()) {
-                (true, true) => {
-                    abs.push((a - r).abs() / diag);
-                    signed.push((a - r) / diag);
-                }
-                (false, false) => {}
-                _ => mask += 1,
-            }
-        }
-        let both = abs.len();
-        let q = |v: &mut Vec<f64>, q: f64| smoothtrace::reports::quantile(v, q).unwrap_or(f64::NAN);
+        let diff = compare_depths(&d.t, &reference.t, 1.0, diag);
+        // Signed: below zero where the render stands in front of the reference.
+        let mut signed: Vec<f64> = (d.t.iter().zip(&reference.t))
+            .filter(|(a, r)| a.is_finite() && r.is_finite())
+            .map(|(&a, &r)| (f64::from(a) - f64::from(r)) / diag)
+            .collect();
+        let sci = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.2e}"));
         println!(
-            "{path}: {} hits, {both} in both, hit or miss differs at {mask}; |t - t_ref| / diag median {:.2e} p99 {:.2e}, signed median {:+.2e}",
+            "{path}: {} hits, {} in both, hit or miss differs at {}; |t - t_ref| / diag median {} p99 {}, signed median {}",
             hits(&d),
-            q(&mut abs, 0.5),
-            q(&mut abs, 0.99),
-            q(&mut signed, 0.5),
+            diff.both,
+            diff.only_one,
+            sci(diff.p50),
+            sci(diff.p99),
+            sci(quantile(&mut signed, 0.5)),
         );
     }
     Ok(())
