@@ -10,55 +10,11 @@
 use glam::DVec3;
 use rayon::prelude::*;
 use smoothtrace::eval::evaluate_value;
+use smoothtrace::geometry::segments::segment_distance2;
 use smoothtrace::primitives::{AnySet, WeightScale};
 use smoothtrace::render::build::build_scene;
 use smoothtrace::scene::Scene;
 use std::path::Path;
-
-/// Squared distance between segments p1q1 and p2q2 (Ericson 5.1.9).
-fn seg_seg2(p1: DVec3, q1: DVec3, p2: DVec3, q2: DVec3) -> f64 {
-    let d1 = q1 - p1;
-    let d2 = q2 - p2;
-    let r = p1 - p2;
-    let a = d1.dot(d1);
-    let e = d2.dot(d2);
-    let f = d2.dot(r);
-    let (s, t);
-    if a <= 1e-30 && e <= 1e-30 {
-        return r.dot(r);
-    }
-    if a <= 1e-30 {
-        s = 0.0;
-        t = (f / e).clamp(0.0, 1.0);
-    } else {
-        let c = d1.dot(r);
-        if e <= 1e-30 {
-            t = 0.0;
-            s = (-c / a).clamp(0.0, 1.0);
-        } else {
-            let b = d1.dot(d2);
-            let denom = a * e - b * b;
-            let mut ss = if denom > 0.0 {
-                ((b * f - c * e) / denom).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let mut tt = (b * ss + f) / e;
-            if tt < 0.0 {
-                tt = 0.0;
-                ss = (-c / a).clamp(0.0, 1.0);
-            } else if tt > 1.0 {
-                tt = 1.0;
-                ss = ((b - c) / a).clamp(0.0, 1.0);
-            }
-            s = ss;
-            t = tt;
-        }
-    }
-    let c1 = p1 + d1 * s;
-    let c2 = p2 + d2 * t;
-    (c1 - c2).length_squared()
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -88,7 +44,7 @@ fn main() {
     let seg_bound = |x: DVec3, y: DVec3| -> f64 {
         let f: Vec<f64> = edges
             .iter()
-            .map(|&(a, b)| seg_seg2(x, y, a, b).sqrt())
+            .map(|&(a, b)| segment_distance2(x, y, a, b).sqrt())
             .collect();
         let m = f.iter().cloned().fold(f64::INFINITY, f64::min);
         let sum: f64 = f.iter().map(|&fj| (-alpha * (fj - m)).exp()).sum();
