@@ -72,13 +72,20 @@ fn run(args: &[String]) -> Result<(), String> {
         .filter(|d: &f64| *d > 0.0 && d.is_finite())
         .ok_or_else(|| format!("DIAG: expected a positive number, got {}", args[1]))?;
     let is_exr = |p: &str| p.to_ascii_lowercase().ends_with(".exr");
+    // The EXR read for the size is kept for its own turn below.
+    let mut probed = None;
     if size.is_none()
         && let Some(p) = args.iter().find(|p| is_exr(p))
     {
         let d = read_exr(p)?;
         size = Some((d.width, d.height));
+        probed = Some((p.clone(), d));
     }
+    let probed = std::cell::RefCell::new(probed);
     let read = |p: &str| match (is_exr(p), size) {
+        (true, _) if probed.borrow().as_ref().is_some_and(|(q, _)| q == p) => {
+            Ok(probed.borrow_mut().take().expect("checked above").1)
+        }
         (true, _) => read_exr(p),
         (false, Some(s)) => read_bin(p, s),
         (false, None) => Err(format!(

@@ -17,22 +17,34 @@ use smoothtrace::scene::Scene;
 use std::path::Path;
 
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let mut scene = Scene::load(Path::new(&args[1])).expect("scene");
+    if let Err(e) = run() {
+        eprintln!("segment_oracle: {e}");
+        std::process::exit(2);
+    }
+}
+
+fn run() -> Result<(), String> {
+    let path = std::env::args()
+        .nth(1)
+        .ok_or("usage: segment_oracle SCENE.toml (one object of edges)")?;
+    let mut scene = Scene::load(Path::new(&path)).map_err(|e| e.to_string())?;
     let (w, h) = (160u32, 90u32);
     scene.image.width = w;
     scene.image.height = h;
-    let built = build_scene(&scene).expect("build");
+    let built = build_scene(&scene).map_err(|e| e.to_string())?;
     let eps = built.epsilon;
     let cam = &built.camera;
-    let obj = &built.objects[0];
+    let (obj, es) = match (
+        built.objects.as_slice(),
+        built.objects.first().map(|o| o.sets.as_slice()),
+    ) {
+        ([obj], Some([AnySet::Edges(es)])) => (obj, es),
+        _ => return Err(format!("{path}: expected one object made of one edge set")),
+    };
     let sets = obj.set_refs();
     let mut p = obj.params;
     p.beta = 0.0;
     let alpha = p.alpha;
-    let AnySet::Edges(es) = &obj.sets[0] else {
-        panic!("edges only")
-    };
     let edges: Vec<(DVec3, DVec3)> = es
         .prims
         .iter()
@@ -59,7 +71,7 @@ fn main() {
         .into_par_iter()
         .filter_map(|(px, py)| {
             let (o, d) = cam.ray(px, py);
-            // start where the ray enters the grown box (crudely: the exact value)
+            // Past the data's box by two diagonals: a miss.
             let t_end =
                 (o - 0.5 * (bounds.min.as_dvec3() + bounds.max.as_dvec3())).length() + 2.0 * diag;
             let march = |seg: bool| -> (bool, u32) {
@@ -119,4 +131,5 @@ fn main() {
             n1 as f64 / sel.len().max(1) as f64
         );
     }
+    Ok(())
 }

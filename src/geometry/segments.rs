@@ -78,16 +78,14 @@ mod tests {
                 }
             }
         }
-        let (mut lo, mut s0, mut t0) = best;
+        // A second grid as fine again over the best cell's neighbours.
+        let (mut lo, s0, t0) = best;
         let h = 1.0 / n as f64;
         for i in 0..=n {
             for j in 0..=n {
                 let s = (s0 + (i as f64 / n as f64 - 0.5) * 2.0 * h).clamp(0.0, 1.0);
                 let t = (t0 + (j as f64 / n as f64 - 0.5) * 2.0 * h).clamp(0.0, 1.0);
-                let d = at(s, t);
-                if d < lo {
-                    (lo, s0, t0) = (d, s, t);
-                }
+                lo = lo.min(at(s, t));
             }
         }
         lo
