@@ -26,14 +26,31 @@ use smoothtrace::reports::quantile;
 use smoothtrace::scene::Scene;
 use std::path::Path;
 
+/// Prints `message` and exits with status 2 (bad arguments or input).
+fn fail(message: String) -> ! {
+    eprintln!("ray_probe: {message}");
+    std::process::exit(2);
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let mut scene = Scene::load(Path::new(&args[1])).expect("scene");
-    let w: u32 = args.get(2).map(|s| s.parse().unwrap()).unwrap_or(160);
-    let h: u32 = args.get(3).map(|s| s.parse().unwrap()).unwrap_or(90);
+    let Some(path) = args.get(1) else {
+        fail("usage: ray_probe SCENE.toml [W H] [MODE ...] (modes: see the file's docs)".into())
+    };
+    let mut scene = Scene::load(Path::new(path)).unwrap_or_else(|e| fail(e.to_string()));
+    let size = |i: usize, default: u32| match args.get(i) {
+        None => default,
+        Some(v) => match v.parse::<u32>() {
+            Ok(n) if n > 0 => n,
+            _ => fail(format!(
+                "argument {i}: expected an image size >= 1, got '{v}'"
+            )),
+        },
+    };
+    let (w, h) = (size(2, 160), size(3, 90));
     scene.image.width = w;
     scene.image.height = h;
-    let built = build_scene(&scene).expect("build");
+    let built = build_scene(&scene).unwrap_or_else(|e| fail(format!("{path}: {e}")));
     // A last argument `fixed-step-beta` turns the tiles' learned step beta off.
     let learn_step_beta = args.last().map(String::as_str) != Some("fixed-step-beta");
     let opts = TracerOptions {
