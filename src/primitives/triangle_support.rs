@@ -182,9 +182,26 @@ impl TriangleLattice {
     }
 
     /// At least `max over p of alpha g . p + ln w(p)` over triangle `tri` (of this
-    /// lattice's valences), in each of the directions `g`.
+    /// lattice's valences), in each of the directions `g` (in AVX lanes where the CPU has
+    /// them, the same arithmetic, so the same bits: `primitives::lanes`).
     #[inline]
     pub fn supports<const N: usize>(&self, tri: &Triangle, g: &[DVec3; N], alpha: f64) -> [f64; N] {
+        #[cfg(target_arch = "x86_64")]
+        if super::lanes::available() {
+            // SAFETY: `lanes::available` found AVX on this CPU.
+            return unsafe { self.supports_avx(tri, g, alpha) };
+        }
+        self.supports_any(tri, g, alpha)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn supports_avx<const N: usize>(&self, tri: &Triangle, g: &[DVec3; N], alpha: f64) -> [f64; N] {
+        self.supports_any(tri, g, alpha)
+    }
+
+    #[inline(always)]
+    fn supports_any<const N: usize>(&self, tri: &Triangle, g: &[DVec3; N], alpha: f64) -> [f64; N] {
         let a = tri.a.as_dvec3();
         let (e1, e2) = (tri.b.as_dvec3() - a, tri.c.as_dvec3() - a);
         let ga: [f64; N] = std::array::from_fn(|k| alpha * g[k].dot(a));
@@ -210,6 +227,27 @@ mod tests {
     use crate::primitives::weights::triangle_w_value;
     use crate::testing::uniform;
     use glam::Vec3;
+
+    /// The supports in lanes (where this CPU has AVX) are the scalar code's bits.
+    #[test]
+    fn supports_in_lanes_are_the_scalar_code_bit_for_bit() {
+        let mut r = uniform(5);
+        let scale = WeightScale::new(9.0, 80.0, 120.0);
+        let lattice = TriangleLattice::new(7.0, 2.0, &scale);
+        for _ in 0..50 {
+            let mut v = || Vec3::new(r() as f32, r() as f32, r() as f32);
+            let tri = Triangle::new(v(), v(), v(), 7.0, 2.0);
+            let g: [DVec3; 26] =
+                std::array::from_fn(|_| DVec3::new(r() - 0.5, r() - 0.5, r() - 0.5) * 3.0);
+            let (a, b) = (
+                lattice.supports(&tri, &g, 80.0),
+                lattice.supports_any(&tri, &g, 80.0),
+            );
+            for k in 0..26 {
+                assert_eq!(a[k].to_bits(), b[k].to_bits(), "direction {k}");
+            }
+        }
+    }
 
     /// The Bernstein coefficients rebuild the weight: at random points of each
     /// sub-triangle the Bernstein sum equals `triangle_w_value`.
