@@ -106,6 +106,22 @@ fn log_sum_exp_any(tables: &[Table]) -> Table {
     })
 }
 
+/// `1 / k!` for `k = 0 .. N` (each `k!` exact in f64 to `k = 22`, so each quotient is
+/// correctly rounded).
+const fn inverse_factorials<const N: usize>() -> [f64; N] {
+    let mut c = [0.0; N];
+    let mut f = 1.0;
+    let mut k = 0;
+    while k < N {
+        if k > 0 {
+            f *= k as f64;
+        }
+        c[k] = 1.0 / f;
+        k += 1;
+    }
+    c
+}
+
 /// `exp(x)` for `x <= 0`, within 2 ulp of the exact value, without a branch or a call,
 /// so that a loop over many of them runs in vector lanes (the tables' build spent a
 /// quarter of its time in libm's `exp`): `2^k p(r)` with `k = round(x / ln 2)`, `r = x -
@@ -125,22 +141,7 @@ fn exp_nonpositive(x: f64) -> f64 {
     let y = xc * std::f64::consts::LOG2_E + ROUND;
     let k = y - ROUND;
     let r = (xc - k * LN2_HI) - k * LN2_LO;
-    const C: [f64; 14] = [
-        1.0,
-        1.0,
-        1.0 / 2.0,
-        1.0 / 6.0,
-        1.0 / 24.0,
-        1.0 / 120.0,
-        1.0 / 720.0,
-        1.0 / 5040.0,
-        1.0 / 40320.0,
-        1.0 / 362_880.0,
-        1.0 / 3_628_800.0,
-        1.0 / 39_916_800.0,
-        1.0 / 479_001_600.0,
-        1.0 / 6_227_020_800.0,
-    ];
+    const C: [f64; 14] = inverse_factorials();
     let mut p = C[13];
     for c in C[..13].iter().rev() {
         p = p * r + c;
