@@ -63,19 +63,12 @@ pub struct DirectionalTables {
 /// time over all the tables, so the exponentials run side by side ([`exp_nonpositive`]).
 fn log_sum_exp(tables: &[Table]) -> Table {
     #[cfg(target_arch = "x86_64")]
-    if *AVX2 {
-        // SAFETY: AVX2 was found on this CPU.
+    if super::lanes::available_avx2() {
+        // SAFETY: `lanes::available_avx2` found AVX2 on this CPU.
         return unsafe { log_sum_exp_avx2(tables) };
     }
     log_sum_exp_any(tables)
 }
-
-/// The CPU has AVX2 (checked once), and the lanes are not turned off
-/// (`primitives::lanes::SCALAR_ENV`).
-#[cfg(target_arch = "x86_64")]
-static AVX2: std::sync::LazyLock<bool> = std::sync::LazyLock::new(|| {
-    super::lanes::available() && std::arch::is_x86_feature_detected!("avx2")
-});
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]

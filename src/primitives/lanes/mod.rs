@@ -46,6 +46,21 @@ pub fn available() -> bool {
     }
 }
 
+/// True when the lanes run on AVX here and the CPU has AVX2 too (its integer lanes:
+/// `directional`'s branch-free `exp` builds `2^k` in them; checked once per process).
+pub fn available_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        static AVX2: std::sync::LazyLock<bool> =
+            std::sync::LazyLock::new(|| available() && std::arch::is_x86_feature_detected!("avx2"));
+        *AVX2
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// Four doubles, one per lane.
 pub type Lanes = [f64; 4];
 /// Four 3-vectors, coordinate by coordinate (`[x, y, z]`, each a lane array).
