@@ -31,7 +31,7 @@ use crate::bvh::moments::MIDDLE;
 use crate::bvh::wide::EMPTY;
 use crate::geometry::directions::DirectionGrid;
 use glam::DVec3;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 /// Entries per wide node: four slots, two middles (`bvh::MIDDLE`).
 const ENTRIES: usize = 6;
@@ -145,26 +145,25 @@ fn exp_nonpositive(x: f64) -> f64 {
     if low { 0.0 } else { v }
 }
 
-/// One `T` per distinct pair of valences (`valences(p)`) among `prims`, made by `make`
-/// from the first primitive with that pair, and each primitive's index into them.
-fn per_valence_pair<P, T>(
-    prims: &[P],
-    valences: impl Fn(&P) -> (f32, f32),
-    make: impl Fn(&P) -> T,
-) -> (Vec<T>, Vec<u32>) {
-    let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
-    let mut made = Vec::new();
+/// The distinct pairs of valences (`valences(p)`) among `prims`: the first primitive with
+/// each pair, in order of first appearance, and each primitive's index into that list.
+/// (Keyed by the valences' bits with rustc's hasher: a hundred thousand primitives with
+/// a few dozen keys, where SipHash's resistance to chosen keys buys nothing.)
+fn valence_pairs<P>(prims: &[P], valences: impl Fn(&P) -> (f32, f32)) -> (Vec<usize>, Vec<u32>) {
+    let mut pairs: FxHashMap<(u32, u32), u32> = FxHashMap::default();
+    let mut firsts = Vec::new();
     let index = prims
         .iter()
-        .map(|p| {
+        .enumerate()
+        .map(|(i, p)| {
             let (a, b) = valences(p);
             *pairs.entry((a.to_bits(), b.to_bits())).or_insert_with(|| {
-                made.push(make(p));
-                made.len() as u32 - 1
+                firsts.push(i);
+                firsts.len() as u32 - 1
             })
         })
         .collect();
-    (made, index)
+    (firsts, index)
 }
 
 /// `ln(e^a + e^b)`, exact for infinities.
@@ -199,21 +198,22 @@ impl DirectionalTables {
     /// The tables of an edge set at sharpness `alpha` (weights by `scale`): `prims` are
     /// the edges in the tree's order and `wide` its nodes.
     pub fn for_edges(prims: &[Edge], wide: &[Node4], alpha: f64, scale: &WeightScale) -> Self {
-        // One envelope per pair of end valences.
-        let (envelopes, envelope_of) = per_valence_pair(
-            prims,
-            |e| (e.val_a, e.val_b),
-            |e| SupportEnvelope::new(&piece_log_weights(e.val_a, e.val_b, scale)),
-        );
+        // One envelope and one split (`support::edge_split`) per pair of end valences.
+        let (firsts, pair_of) = valence_pairs(prims, |e| (e.val_a, e.val_b));
+        let envelopes: Vec<SupportEnvelope> = firsts
+            .iter()
+            .map(|&i| {
+                let e = &prims[i];
+                SupportEnvelope::new(&piece_log_weights(e.val_a, e.val_b, scale))
+            })
+            .collect();
         let mut tables = Self::build(wide, alpha, scale, |p, dirs| {
-            envelopes[envelope_of[p] as usize].supports(&prims[p], dirs, alpha)
+            envelopes[pair_of[p] as usize].supports(&prims[p], dirs, alpha)
         });
-        // Each edge's split (`support::edge_split`), one per pair of end valences.
-        let (pairs, pair_of) = per_valence_pair(
-            prims,
-            |e| (e.val_a, e.val_b),
-            |e| edge_split(e.val_a, e.val_b, scale),
-        );
+        let pairs: Vec<(f64, f64)> = firsts
+            .iter()
+            .map(|&i| edge_split(prims[i].val_a, prims[i].val_b, scale))
+            .collect();
         let splits: Vec<(f64, f64)> = pair_of.iter().map(|&k| pairs[k as usize]).collect();
         let ends = Self::build(wide, alpha, scale, |p, dirs| {
             ends_supports(&prims[p], splits[p].0, dirs, alpha)
@@ -229,11 +229,11 @@ impl DirectionalTables {
         alpha: f64,
         scale: &WeightScale,
     ) -> Self {
-        let (lattices, lattice_of) = per_valence_pair(
-            prims,
-            |t| (t.vmax, t.emax),
-            |t| TriangleLattice::new(t.vmax, t.emax, scale),
-        );
+        let (firsts, lattice_of) = valence_pairs(prims, |t| (t.vmax, t.emax));
+        let lattices: Vec<TriangleLattice> = firsts
+            .iter()
+            .map(|&i| TriangleLattice::new(prims[i].vmax, prims[i].emax, scale))
+            .collect();
         Self::build(wide, alpha, scale, |p, dirs| {
             lattices[lattice_of[p] as usize].supports(&prims[p], dirs, alpha)
         })
