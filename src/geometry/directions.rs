@@ -21,6 +21,10 @@
 //!   `f(u) <= sum (mu_k / S) f(S g_k) + (1 - M / S) f(0)`,
 //!
 //! which a table of `f` at the scaled grid directions and at 0 bounds.
+//!
+//! The fold maps the square's border onto itself (`(1, py)` and `(1, -py)` are one
+//! direction, and so on each side; the four corners are all `-z`), so the grid keeps each
+//! direction once: `n^2 - 2 n + 3` of them, 18 of the 25 points at `n = 5`.
 
 use super::closest::closest_on_triangle;
 use glam::DVec3;
@@ -29,16 +33,31 @@ use glam::DVec3;
 #[derive(Clone, Debug)]
 pub struct DirectionGrid {
     n: usize,
-    /// The unit directions of the grid points, row by row (`py` outer).
+    /// The distinct unit directions of the grid points, in the order of their first
+    /// point (row by row, `py` outer).
     unit: Vec<DVec3>,
     /// The lengths of their octahedron points.
     oct_len: Vec<f64>,
-    /// Per square `(i, j)` (`j (n - 1) + i`): its two triangles' grid points, lower then
-    /// upper (`triangle`).
+    /// Per square `(i, j)` (`j (n - 1) + i`): its two triangles' directions, lower then
+    /// upper (`triangle`, each grid point as its direction's index).
     triangles: Vec<[usize; 3]>,
     /// Per square: px and py have one sign there (the fold runs along its anti-diagonal).
     anti: Vec<bool>,
     scale: f64,
+}
+
+/// The distinct directions of an `n x n` grid (`n` odd): the `(n - 2)^2` inner points,
+/// `(n - 1) / 2` per side of the border (`(1, py)` and `(1, -py)` fold onto one) and
+/// the corners' one, `-z`.
+pub const fn distinct_directions(n: usize) -> usize {
+    n * n - 2 * n + 3
+}
+
+/// The parameter coordinate of grid line `i` of `n`, `(2 i - (n - 1)) / (n - 1)`, one
+/// quotient of integers: lines `i` and `n - 1 - i` get opposite values exactly, so the
+/// fold's copies of a direction come out equal.
+fn grid_coordinate(i: usize, n: usize) -> f64 {
+    (2 * i as i64 - (n as i64 - 1)) as f64 / (n - 1) as f64
 }
 
 /// The octahedron point of the parameter point `(px, py)`.
@@ -59,46 +78,54 @@ impl DirectionGrid {
     /// The grid of `n x n` parameter points, `n` odd and at least 3.
     pub fn new(n: usize) -> DirectionGrid {
         assert!(n >= 3 && n % 2 == 1, "a direction grid needs an odd n >= 3");
-        let h = 2.0 / (n - 1) as f64;
         let oct: Vec<DVec3> = (0..n * n)
-            .map(|k| decode(-1.0 + (k % n) as f64 * h, -1.0 + (k / n) as f64 * h))
+            .map(|k| decode(grid_coordinate(k % n, n), grid_coordinate(k / n, n)))
             .collect();
-        let unit: Vec<DVec3> = oct.iter().map(|o| o.normalize()).collect();
-        let oct_len: Vec<f64> = oct.iter().map(|o| o.length()).collect();
+        // The fold maps the square's border onto itself: `(1, py)` and `(1, -py)` are one
+        // direction, and so on each side, and the four corners are `-z`. Each direction
+        // is kept once, in the order of its first grid point.
+        let mut distinct: Vec<DVec3> = Vec::new();
+        let of_point: Vec<usize> = oct
+            .iter()
+            .map(|o| {
+                // (`==` takes -0 for 0, which is all the fold's copies differ by.)
+                distinct.iter().position(|d| d == o).unwrap_or_else(|| {
+                    distinct.push(*o);
+                    distinct.len() - 1
+                })
+            })
+            .collect();
         let mut grid = DirectionGrid {
             n,
-            unit,
-            oct_len,
+            unit: distinct.iter().map(|o| o.normalize()).collect(),
+            oct_len: distinct.iter().map(|o| o.length()).collect(),
             triangles: Vec::new(),
             anti: Vec::new(),
             scale: 1.0,
         };
         for j in 0..n - 1 {
             for i in 0..n - 1 {
-                grid.triangles.push(grid.triangle(i, j, false));
-                grid.triangles.push(grid.triangle(i, j, true));
+                for upper in [false, true] {
+                    let t = grid.triangle(i, j, upper);
+                    grid.triangles.push(t.map(|k| of_point[k]));
+                }
                 grid.anti.push(grid.anti_square(i, j));
             }
         }
         let mut nearest = f64::INFINITY;
-        for j in 0..n - 1 {
-            for i in 0..n - 1 {
-                for upper in [false, true] {
-                    let t = grid.triangle(i, j, upper);
-                    let [a, b, c] = t.map(|k| grid.unit[k]);
-                    let d = closest_on_triangle(DVec3::ZERO, a, b, c).point.length();
-                    nearest = nearest.min(d);
-                }
-            }
+        for t in &grid.triangles {
+            let [a, b, c] = t.map(|k| grid.unit[k]);
+            let d = closest_on_triangle(DVec3::ZERO, a, b, c).point.length();
+            nearest = nearest.min(d);
         }
         // Rounded up past the rounding of the distance and of `mu`.
         grid.scale = (1.0 / nearest) * (1.0 + 1e-12);
         grid
     }
 
-    /// The number of grid directions.
+    /// The number of distinct grid directions: `n^2 - 2 n + 3` ([`distinct_directions`]).
     pub fn len(&self) -> usize {
-        self.n * self.n
+        self.unit.len()
     }
 
     /// Never empty (`n >= 3`).
@@ -111,7 +138,7 @@ impl DirectionGrid {
         self.scale
     }
 
-    /// Grid direction `k`, unit length.
+    /// Distinct grid direction `k` (`k < len()`), unit length.
     pub fn direction(&self, k: usize) -> DVec3 {
         self.unit[k]
     }
@@ -125,7 +152,7 @@ impl DirectionGrid {
         cx * cy > 0.0
     }
 
-    /// The grid points of triangle `upper` (0 or 1) of square `(i, j)`.
+    /// The grid points (`py` outer) of triangle `upper` (0 or 1) of square `(i, j)`.
     fn triangle(&self, i: usize, j: usize, upper: bool) -> [usize; 3] {
         let v = |a: usize, b: usize| (j + b) * self.n + i + a;
         match (self.anti_square(i, j), upper) {
@@ -222,6 +249,29 @@ mod tests {
         out.push(DVec3::new(-1.0, 0.5, 0.0).normalize());
         out.push(DVec3::new(0.3, -0.7, 0.0).normalize());
         out
+    }
+
+    /// The fold's copies are kept once: as many directions as `distinct_directions`
+    /// says, all different, and every grid point's direction among them.
+    #[test]
+    fn the_grid_keeps_each_direction_once() {
+        for n in [3, 5, 7, 9] {
+            let grid = DirectionGrid::new(n);
+            assert_eq!(grid.len(), distinct_directions(n), "n {n}");
+            for a in 0..grid.len() {
+                for b in 0..a {
+                    assert!(grid.direction(a) != grid.direction(b), "n {n}: {a} and {b}");
+                }
+            }
+            for k in 0..n * n {
+                let o = decode(grid_coordinate(k % n, n), grid_coordinate(k / n, n));
+                let u = o.normalize();
+                assert!(
+                    (0..grid.len()).any(|d| grid.direction(d) == u),
+                    "n {n}: point {k} ({u}) has no direction"
+                );
+            }
+        }
     }
 
     #[test]

@@ -29,18 +29,19 @@ use super::weights::WeightScale;
 use crate::bvh::Node4;
 use crate::bvh::moments::MIDDLE;
 use crate::bvh::wide::EMPTY;
-use crate::geometry::directions::DirectionGrid;
+use crate::geometry::directions::{DirectionGrid, distinct_directions};
 use glam::DVec3;
 use rustc_hash::FxHashMap;
 
 /// Entries per wide node: four slots, two middles (`bvh::MIDDLE`).
 const ENTRIES: usize = 6;
 
-/// The grid's side: `GRID * GRID` directions (`geometry::directions`).
+/// The grid's side: `GRID * GRID` points (`geometry::directions`), 18 distinct
+/// directions.
 const GRID: usize = 5;
 
-/// Values per entry: the grid's directions, then the direction 0.
-const VALUES: usize = GRID * GRID + 1;
+/// Values per entry: the grid's distinct directions, then the direction 0.
+const VALUES: usize = distinct_directions(GRID) + 1;
 
 /// An entry's values, before rounding to f32.
 type Table = [f64; VALUES];
@@ -250,6 +251,7 @@ impl DirectionalTables {
     ) -> Self {
         use rayon::prelude::*;
         let grid = DirectionGrid::new(GRID);
+        assert_eq!(grid.len() + 1, VALUES, "the direction grid's size");
         // The grid's scaled directions, then 0.
         let dirs: [DVec3; VALUES] = std::array::from_fn(|k| {
             if k + 1 < VALUES {
