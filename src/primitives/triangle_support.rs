@@ -76,9 +76,32 @@ fn binomial(n: usize, k: usize) -> f64 {
     (0..k).fold(1.0, |c, m| c * (n - m) as f64 / (m + 1) as f64)
 }
 
-/// The blossom of `s^a t^b` in degree [`DEGREE`] at the points `corners` taken `mult`
-/// times each (module docs).
-fn blossom(a: usize, b: usize, corners: &[(f64, f64); 3], mult: [usize; 3]) -> f64 {
+/// `binomial(n, k)` for `n, k <= DEGREE`, and each corner's coordinates' powers up to
+/// `DEGREE` (`powi`): what [`blossom`] multiplies, looked up instead of recomputed in its
+/// innermost loop (the same values, so the same sums).
+struct BlossomParts {
+    binomial: [[f64; DEGREE + 1]; DEGREE + 1],
+    /// Per corner: `(s^k, t^k)`.
+    powers: [[(f64, f64); DEGREE + 1]; 3],
+}
+
+impl BlossomParts {
+    fn new(corners: &[(f64, f64); 3]) -> BlossomParts {
+        BlossomParts {
+            binomial: std::array::from_fn(|n| std::array::from_fn(|k| binomial(n, k))),
+            powers: std::array::from_fn(|m| {
+                let (s, t) = corners[m];
+                std::array::from_fn(|k| (s.powi(k as i32), t.powi(k as i32)))
+            }),
+        }
+    }
+}
+
+/// The blossom of `s^a t^b` in degree [`DEGREE`] at the points `corners` (their parts in
+/// `parts`) taken `mult` times each (module docs).
+fn blossom(a: usize, b: usize, parts: &BlossomParts, mult: [usize; 3]) -> f64 {
+    let c = &parts.binomial;
+    let p = &parts.powers;
     let mut sum = 0.0;
     // `a_m` of corner m's copies go to `s`, `b_m` of the rest to `t`.
     for a0 in 0..=a.min(mult[0]) {
@@ -93,25 +116,24 @@ fn blossom(a: usize, b: usize, corners: &[(f64, f64); 3], mult: [usize; 3]) -> f
                     if b2 > mult[2] - a2 {
                         continue;
                     }
-                    let ways = binomial(mult[0], a0)
-                        * binomial(mult[0] - a0, b0)
-                        * binomial(mult[1], a1)
-                        * binomial(mult[1] - a1, b1)
-                        * binomial(mult[2], a2)
-                        * binomial(mult[2] - a2, b2);
-                    let (p0, p1, p2) = (corners[0], corners[1], corners[2]);
+                    let ways = c[mult[0]][a0]
+                        * c[mult[0] - a0][b0]
+                        * c[mult[1]][a1]
+                        * c[mult[1] - a1][b1]
+                        * c[mult[2]][a2]
+                        * c[mult[2] - a2][b2];
                     sum += ways
-                        * p0.0.powi(a0 as i32)
-                        * p1.0.powi(a1 as i32)
-                        * p2.0.powi(a2 as i32)
-                        * p0.1.powi(b0 as i32)
-                        * p1.1.powi(b1 as i32)
-                        * p2.1.powi(b2 as i32);
+                        * p[0][a0].0
+                        * p[1][a1].0
+                        * p[2][a2].0
+                        * p[0][b0].1
+                        * p[1][b1].1
+                        * p[2][b2].1;
                 }
             }
         }
     }
-    sum / (binomial(DEGREE, a) * binomial(DEGREE - a, b))
+    sum / (c[DEGREE][a] * c[DEGREE - a][b])
 }
 
 /// The Bernstein indices `(i, j, k)`, `i + j + k = DEGREE`.
@@ -124,17 +146,20 @@ fn indices() -> impl Iterator<Item = [usize; 3]> {
 fn bernstein_tables() -> &'static [[[f64; 13]; COEFFICIENTS]] {
     static TABLES: std::sync::OnceLock<Vec<[[f64; 13]; COEFFICIENTS]>> = std::sync::OnceLock::new();
     TABLES.get_or_init(|| {
+        use rayon::prelude::*;
         let h = 1.0 / SIDE as f64;
+        // Sub-triangles in parallel (each its own sums; about 90 M instructions in all).
         sub_triangles()
-            .iter()
+            .par_iter()
             .map(|sub| {
                 let corners = sub.map(|(i, j)| (i as f64 * h, j as f64 * h));
+                let parts = BlossomParts::new(&corners);
                 let mut table = [[0.0; 13]; COEFFICIENTS];
                 for (row, mult) in table.iter_mut().zip(indices()) {
                     for (g, monomials) in GROUPS.iter().enumerate() {
                         row[g] = monomials
                             .iter()
-                            .map(|&(a, b)| blossom(a, b, &corners, mult))
+                            .map(|&(a, b)| blossom(a, b, &parts, mult))
                             .sum();
                     }
                 }
@@ -227,6 +252,66 @@ mod tests {
     use crate::primitives::weights::triangle_w_value;
     use crate::testing::uniform;
     use glam::Vec3;
+
+    /// The blossom as first written, every binomial and power computed where it is used.
+    fn blossom_direct(a: usize, b: usize, corners: &[(f64, f64); 3], mult: [usize; 3]) -> f64 {
+        let mut sum = 0.0;
+        for a0 in 0..=a.min(mult[0]) {
+            for a1 in 0..=(a - a0).min(mult[1]) {
+                let a2 = a - a0 - a1;
+                if a2 > mult[2] {
+                    continue;
+                }
+                for b0 in 0..=b.min(mult[0] - a0) {
+                    for b1 in 0..=(b - b0).min(mult[1] - a1) {
+                        let b2 = b - b0 - b1;
+                        if b2 > mult[2] - a2 {
+                            continue;
+                        }
+                        let ways = binomial(mult[0], a0)
+                            * binomial(mult[0] - a0, b0)
+                            * binomial(mult[1], a1)
+                            * binomial(mult[1] - a1, b1)
+                            * binomial(mult[2], a2)
+                            * binomial(mult[2] - a2, b2);
+                        let (p0, p1, p2) = (corners[0], corners[1], corners[2]);
+                        sum += ways
+                            * p0.0.powi(a0 as i32)
+                            * p1.0.powi(a1 as i32)
+                            * p2.0.powi(a2 as i32)
+                            * p0.1.powi(b0 as i32)
+                            * p1.1.powi(b1 as i32)
+                            * p2.1.powi(b2 as i32);
+                    }
+                }
+            }
+        }
+        sum / (binomial(DEGREE, a) * binomial(DEGREE - a, b))
+    }
+
+    /// The looked-up parts give the direct blossom's bits on every sub-triangle, index
+    /// and monomial the tables use.
+    #[test]
+    fn blossoms_from_looked_up_parts_are_the_direct_ones() {
+        let h = 1.0 / SIDE as f64;
+        for sub in sub_triangles() {
+            let corners = sub.map(|(i, j)| (i as f64 * h, j as f64 * h));
+            let parts = BlossomParts::new(&corners);
+            for mult in indices() {
+                for &(a, b) in GROUPS.iter().flat_map(|g| g.iter()) {
+                    let (fast, direct) = (
+                        blossom(a, b, &parts, mult),
+                        blossom_direct(a, b, &corners, mult),
+                    );
+                    assert_eq!(
+                        fast.to_bits(),
+                        direct.to_bits(),
+                        "{sub:?} {mult:?} s^{a} t^{b}"
+                    );
+                }
+            }
+        }
+    }
 
     /// The supports in lanes (where this CPU has AVX) are the scalar code's bits.
     #[test]
