@@ -143,6 +143,21 @@ impl DirectionGrid {
         self.unit[k]
     }
 
+    /// The grid's directions in opposite pairs `(k, l)`, `direction(l) = -direction(k)`
+    /// exactly, `k < l`. The grid is symmetric through the origin (`(px, py)` and its
+    /// fold's image of `(-px, -py)`), and where `n - 1` is a power of two the fold's
+    /// arithmetic is exact, so every direction is in one pair; elsewhere (`n = 7`) the
+    /// rounding of `1 - |py|` leaves some without theirs.
+    pub fn antipodal_pairs(&self) -> Vec<(usize, usize)> {
+        let mut pairs = Vec::new();
+        for k in 0..self.len() {
+            if let Some(l) = (k + 1..self.len()).find(|&l| self.unit[l] == -self.unit[k]) {
+                pairs.push((k, l));
+            }
+        }
+        pairs
+    }
+
     /// Where px and py have one sign the fold line runs along the squares'
     /// anti-diagonals, elsewhere along their diagonals.
     fn anti_square(&self, i: usize, j: usize) -> bool {
@@ -270,6 +285,23 @@ mod tests {
                     (0..grid.len()).any(|d| grid.direction(d) == u),
                     "n {n}: point {k} ({u}) has no direction"
                 );
+            }
+        }
+    }
+
+    /// Every direction has its opposite in the grid, to the bit, where `n - 1` is a power
+    /// of two (the tables' `n = 5` among them).
+    #[test]
+    fn the_grid_pairs_up_through_the_origin() {
+        for n in [3, 5, 9, 17] {
+            let grid = DirectionGrid::new(n);
+            let pairs = grid.antipodal_pairs();
+            assert_eq!(2 * pairs.len(), grid.len(), "n {n}");
+            let mut seen = vec![false; grid.len()];
+            for (k, l) in pairs {
+                assert_eq!(grid.direction(l), -grid.direction(k), "n {n}");
+                assert!(!seen[k] && !seen[l], "n {n}: {k} or {l} twice");
+                (seen[k], seen[l]) = (true, true);
             }
         }
     }

@@ -43,6 +43,9 @@ const GRID: usize = 5;
 /// Values per entry: the grid's distinct directions, then the direction 0.
 const VALUES: usize = distinct_directions(GRID) + 1;
 
+/// The grid's directions in opposite pairs (`DirectionGrid::antipodal_pairs`).
+const PAIRS: usize = (VALUES - 1) / 2;
+
 /// An entry's values, before rounding to f32.
 type Table = [f64; VALUES];
 
@@ -208,8 +211,34 @@ impl DirectionalTables {
                 SupportEnvelope::new(&piece_log_weights(e.val_a, e.val_b, scale))
             })
             .collect();
-        let mut tables = Self::build(wide, alpha, scale, |p, dirs| {
-            envelopes[pair_of[p] as usize].supports(&prims[p], dirs, alpha)
+        // The grid's directions come in opposite pairs (every one, at `GRID` 5:
+        // `DirectionGrid::antipodal_pairs`): the envelope takes each pair at once
+        // (`SupportEnvelope::supports_antipodal`), and the direction 0 apart.
+        let grid = DirectionGrid::new(GRID);
+        let pairs = grid.antipodal_pairs();
+        assert_eq!(
+            2 * pairs.len() + 1,
+            VALUES,
+            "the direction grid's opposite pairs"
+        );
+        let pairs: [(usize, usize); PAIRS] = std::array::from_fn(|i| pairs[i]);
+        let ahead: [DVec3; PAIRS] =
+            std::array::from_fn(|i| grid.scale() * grid.direction(pairs[i].0));
+        // At 0 every edge of a pair of valences has the same support, its envelope's
+        // largest intercept (rounded up).
+        let at_zero: Vec<f64> = firsts
+            .iter()
+            .zip(&envelopes)
+            .map(|(&i, envelope)| envelope.supports(&prims[i], &[DVec3::ZERO], alpha)[0])
+            .collect();
+        let mut tables = Self::build(wide, alpha, scale, |p, _| {
+            let pair = pair_of[p] as usize;
+            let (plus, minus) = envelopes[pair].supports_antipodal(&prims[p], &ahead, alpha);
+            let mut t = [at_zero[pair]; VALUES];
+            for (i, &(k, l)) in pairs.iter().enumerate() {
+                (t[k], t[l]) = (plus[i], minus[i]);
+            }
+            t
         });
         let pairs: Vec<(f64, f64)> = firsts
             .iter()
