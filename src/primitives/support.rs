@@ -329,7 +329,7 @@ mod tests {
             let d = (e.b - e.a).as_dvec3();
             let mut g: [DVec3; 5] =
                 std::array::from_fn(|_| DVec3::new(r() - 0.5, r() - 0.5, r() - 0.5) * 2.6);
-            // At right angles to the edge, and along its axes' zero components.
+            // At right angles to the edge (`g . d` zero), and 0 with a negative zero.
             g[3] = d.any_orthonormal_vector();
             g[4] = DVec3::new(0.0, -0.0, 0.0);
             let (plus, minus) = env.supports_antipodal(&e, &g, alpha);
