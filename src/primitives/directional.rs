@@ -231,7 +231,7 @@ impl DirectionalTables {
             .zip(&envelopes)
             .map(|(&i, envelope)| envelope.supports(&prims[i], &[DVec3::ZERO], alpha)[0])
             .collect();
-        let mut tables = Self::build(wide, alpha, scale, |p, _| {
+        let mut tables = Self::build(wide, &grid, alpha, scale, |p, _| {
             let pair = pair_of[p] as usize;
             let (plus, minus) = envelopes[pair].supports_antipodal(&prims[p], &ahead, alpha);
             let mut t = [at_zero[pair]; VALUES];
@@ -240,12 +240,12 @@ impl DirectionalTables {
             }
             t
         });
-        let pairs: Vec<(f64, f64)> = firsts
+        let pair_splits: Vec<(f64, f64)> = firsts
             .iter()
             .map(|&i| edge_split(prims[i].val_a, prims[i].val_b, scale))
             .collect();
-        let splits: Vec<(f64, f64)> = pair_of.iter().map(|&k| pairs[k as usize]).collect();
-        let ends = Self::build(wide, alpha, scale, |p, dirs| {
+        let splits: Vec<(f64, f64)> = pair_of.iter().map(|&k| pair_splits[k as usize]).collect();
+        let ends = Self::build(wide, &grid, alpha, scale, |p, dirs| {
             ends_supports(&prims[p], splits[p].0, dirs, alpha)
         });
         tables.split = Some(SplitTables::new(prims, wide, &splits, ends.values));
@@ -264,22 +264,22 @@ impl DirectionalTables {
             .iter()
             .map(|&i| TriangleLattice::new(prims[i].vmax, prims[i].emax, scale))
             .collect();
-        Self::build(wide, alpha, scale, |p, dirs| {
+        Self::build(wide, &DirectionGrid::new(GRID), alpha, scale, |p, dirs| {
             lattices[lattice_of[p] as usize].supports(&prims[p], dirs, alpha)
         })
     }
 
     /// The tables from each primitive's weighted supports (`supports(p, dirs)` for
-    /// primitive `p` in the tree's order), on a [`GRID`] x [`GRID`] grid. The leaves'
+    /// primitive `p` in the tree's order), on `grid` (of side [`GRID`]). The leaves'
     /// slots are summed in parallel, then the tree a level at a time.
     fn build(
         wide: &[Node4],
+        grid: &DirectionGrid,
         alpha: f64,
         scale: &WeightScale,
         supports: impl Fn(usize, &[DVec3; VALUES]) -> Table + Sync,
     ) -> Self {
         use rayon::prelude::*;
-        let grid = DirectionGrid::new(GRID);
         assert_eq!(grid.len() + 1, VALUES, "the direction grid's size");
         // The grid's scaled directions, then 0.
         let dirs: [DVec3; VALUES] = std::array::from_fn(|k| {
@@ -375,7 +375,7 @@ impl DirectionalTables {
             }
         }
         DirectionalTables {
-            grid,
+            grid: grid.clone(),
             alpha,
             q: scale.q,
             values,
